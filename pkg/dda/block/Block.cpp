@@ -1,0 +1,21 @@
+#include "Block.hpp"
+
+#include <cmath>
+#include <sstream>
+
+namespace dda {
+
+void validateMaterial(const Material& material) {
+	std::ostringstream message;
+	if (!(std::isfinite(material.density) && material.density > 0))
+		message << "density must be positive and finite, got " << material.density << " kg/m^3";
+	else if (!(std::isfinite(material.young) && material.young > 0))
+		message << "Young's modulus must be positive and finite, got " << material.young << " Pa";
+	else if (!(std::isfinite(material.poisson) && material.poisson > -1 && material.poisson < 0.5))
+		message << "Poisson's ratio must lie in (-1, 0.5), got " << material.poisson;
+	else
+		return;
+	throw InputError(message.str());
+}
+
+}  // namespace dda

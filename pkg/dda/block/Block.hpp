@@ -1,0 +1,64 @@
+// State of one DDA block: its current geometry, mass properties, velocity in
+// the 12 unknowns, stress, supports and loads. All quantities SI and global.
+#pragma once
+
+#include "Displacement.hpp"
+#include "dda/geometry/ConvexPolyhedron.hpp"
+
+#include <Eigen/Geometry>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace dda {
+
+// Isotropic linear elastic block material.
+struct Material {
+	double density = 2600;  // kg/m^3, > 0
+	double young = 1e9;     // Pa, > 0
+	double poisson = 0.25;  // -, in (-1, 0.5)
+};
+
+// Throws InputError naming the offending value.
+void validateMaterial(const Material& material);
+
+// A penalty spring pulling a material point of the block back to its anchor.
+struct FixedPoint {
+	Vector3 position;  // current position of the material point [m]
+	Vector3 anchor;    // where the spring holds it [m]
+	double stiffness;  // [N/m]; <= 0: IntegratorSettings::fixedPointPenaltyFactor x E x size
+};
+
+// A constant force [N] (global direction) acting on a material point [m].
+struct PointLoad {
+	Vector3 position;
+	Vector3 force;
+};
+
+struct Block {
+	std::shared_ptr<const ConvexPolyhedron> shape;  // topology; vertices as created
+	std::vector<Vector3> vertices;                  // current positions [m]
+	Vector3 centroid = Vector3::Zero();             // [m]
+	double volume = 0;                              // [m^3]
+	Matrix3 secondMoment = Matrix3::Zero();         // integral of d d^T dV [m^5]
+	double mass = 0;                                // [kg], conserved
+	Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();  // accumulated since creation
+	Vector12 velocity = Vector12::Zero();  // rates of the 12 unknowns [m/s, rad/s, 1/s]
+	Vector6 stress = Vector6::Zero();      // (sxx, syy, szz, sxy, syz, szx) [Pa]
+	Vector6 strain = Vector6::Zero();      // accumulated (ex, ey, ez, gxy, gyz, gzx) [-]
+	Material material;
+	Matrix6 elasticity = Matrix6::Zero();  // of the material [Pa]
+	bool fixed = false;  // a fixed block has no unknowns: it never moves
+	std::vector<FixedPoint> fixedPoints;
+	std::vector<PointLoad> loads;
+	// Sum of |strain increment| since the YADE body's vertices were last
+	// written; a sync rewrites them only when this exceeds round-off.
+	double unsyncedStrain = 0;
+
+	double density() const { return mass / volume; }  // current [kg/m^3]
+	// Characteristic length: cube root of the volume at creation [m].
+	double size = 0;
+};
+
+}  // namespace dda

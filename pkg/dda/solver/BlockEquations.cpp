@@ -1,0 +1,68 @@
+#include "BlockEquations.hpp"
+
+#include <algorithm>
+
+namespace dda {
+
+void assembleBlock(const Block& block, const IntegratorSettings& settings, double dt, BlockSystem& system) {
+	const Vector12 v0 = startVelocity(block, settings);
+	const Matrix12 mass = massMatrix(block.density(), block.volume, block.secondMoment);
+	system.stiffness.noalias() = (2 / (dt * dt)) * mass;
+	system.force.noalias() = (2 / dt) * (mass * v0);
+
+	system.stiffness.block<6, 6>(6, 6).noalias() += block.volume * block.elasticity;
+	system.force.segment<6>(6).noalias() -= block.volume * block.stress;
+
+	if (!settings.gravity.isZero()) system.force.head<3>() += block.mass * settings.gravity;
+
+	for (const FixedPoint& point : block.fixedPoints) {
+		const Matrix3x12 T = displacementMatrix(point.position - block.centroid);
+		const double stiffness = point.stiffness > 0 ? point.stiffness
+		                                             : settings.fixedPointPenaltyFactor * block.material.young * block.size;
+		system.stiffness.noalias() += stiffness * T.transpose() * T;
+		system.force.noalias() += stiffness * T.transpose() * (point.anchor - point.position);
+	}
+	for (const PointLoad& load : block.loads)
+		system.force.noalias() += displacementMatrix(load.position - block.centroid).transpose() * load.force;
+}
+
+double largestVertexDisplacement(const Block& block, const Vector12& D) {
+	double largest = 0;
+	for (const Vector3& x : block.vertices)
+		largest = std::max(largest, displacementAt(x - block.centroid, D).squaredNorm());
+	return std::sqrt(largest);
+}
+
+void applyStep(Block& block, const Vector12& D, const Vector12& v0, double dt) {
+	const Matrix3 rotation = rotationFromVector(D.segment<3>(3));
+	const Matrix3 strain = strainTensor(D.segment<6>(6));
+	const Matrix3 deformation = (Matrix3::Identity() + strain) * rotation;
+	const Vector3 oldCentroid = block.centroid;
+	const Vector3 newCentroid = oldCentroid + D.head<3>();
+	auto move = [&](const Vector3& x) -> Vector3 { return newCentroid + deformation * (x - oldCentroid); };
+
+	for (Vector3& x : block.vertices) x = move(x);
+	for (FixedPoint& point : block.fixedPoints) point.position = move(point.position);
+	for (PointLoad& load : block.loads) load.position = move(load.position);
+
+	// An affine map x -> c' + L (x - c) maps the centroid to c' and scales
+	// volume by det L; the second moments transform as det(L) L J L^T (exact).
+	const double jacobian = deformation.determinant();
+	block.centroid = newCentroid;
+	block.volume *= jacobian;
+	block.secondMoment = jacobian * deformation * block.secondMoment * deformation.transpose();
+	block.rotation = (Eigen::Quaterniond(rotation) * block.rotation).normalized();
+
+	// End velocity of the step; tensors follow the block's rotation.
+	Vector12 velocity = (2 / dt) * D - v0;
+	const Matrix3 strainRate = rotation * strainTensor(velocity.segment<6>(6)) * rotation.transpose();
+	velocity.segment<6>(6) = strainVoigt(strainRate);
+	block.velocity = velocity;
+
+	const Vector6 strainIncrement = D.segment<6>(6);
+	block.stress = stressVoigt(rotation * stressTensor(block.stress) * rotation.transpose()) + block.elasticity * strainIncrement;
+	block.strain = strainVoigt(rotation * strainTensor(block.strain) * rotation.transpose()) + strainIncrement;
+	block.unsyncedStrain += strainIncrement.norm();
+}
+
+}  // namespace dda

@@ -1,0 +1,43 @@
+// The equations of one block for one time step, without contacts, and the
+// update of its state once the step is accepted.
+//
+// Shi's time scheme assumes a constant acceleration over the step:
+//   D = v0 dt + a dt^2 / 2,   v1 = 2 D / dt - v0.
+// The inertia force -rho a then contributes (2/dt^2) M D = (2/dt) M v0 + ...,
+// with M the consistent mass matrix (Displacement.hpp). Further terms, each the
+// derivative of a potential energy with respect to D:
+//   elastic strain energy     V/2 eps^T E eps        -> K_ee += V E
+//   stress of the last step   V sigma^T eps          -> F_e  -= V sigma
+//   gravity                   -m g . t               -> F_t  += m g
+//   fixed point (penalty k)   k/2 |x + T(x)D - a|^2  -> K += k T^T T, F += k T^T (a - x)
+//   point load f at x         -f . T(x) D            -> F += T^T f
+// The scheme is exact for a constant acceleration (free fall) and, being
+// Newmark with gamma = 1, dissipates high frequencies: it never creates energy.
+#pragma once
+
+#include "IntegratorSettings.hpp"
+#include "dda/block/Block.hpp"
+
+namespace dda {
+
+struct BlockSystem {
+	Matrix12 stiffness;
+	Vector12 force;
+};
+
+// Start-of-step velocity: the carried velocity scaled by Shi's dynamic coefficient.
+inline Vector12 startVelocity(const Block& block, const IntegratorSettings& settings) {
+	return settings.velocityRatio * block.velocity;
+}
+
+void assembleBlock(const Block& block, const IntegratorSettings& settings, double dt, BlockSystem& system);
+
+// Largest displacement of a vertex for the unknowns D [m].
+double largestVertexDisplacement(const Block& block, const Vector12& D);
+
+// Applies an accepted step: exact rotation about the centroid, then the strain,
+// to vertices, supports, loads and mass properties; new velocity; stress update
+// (the old stress rotated with the block plus E times the strain increment).
+void applyStep(Block& block, const Vector12& D, const Vector12& startVelocity, double dt);
+
+}  // namespace dda

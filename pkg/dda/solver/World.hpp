@@ -1,0 +1,50 @@
+// The DDA scene: its blocks and the implicit step that advances them.
+// One World per YADE scene; the Python side maps YADE body ids to block indices.
+#pragma once
+
+#include "BlockEquations.hpp"
+#include "IntegratorSettings.hpp"
+#include "dda/block/Block.hpp"
+
+#include <vector>
+
+namespace dda {
+
+class World {
+public:
+	// Builds and validates a block (throws InputError; the world is unchanged then).
+	int addBlock(const std::vector<Vector3>& points, const Material& material, bool fixed);
+	int blockCount() const { return static_cast<int>(blocks_.size()); }
+	Block& block(int index);
+	const Block& block(int index) const;
+
+	// Holds the material point now at `position` of a block with a penalty spring
+	// [N/m]; stiffness <= 0 picks IntegratorSettings' default at each step.
+	void addFixedPoint(int index, const Vector3& position, double stiffness);
+	void addPointLoad(int index, const Vector3& position, const Vector3& force);
+	void setVelocity(int index, const Vector3& velocity, const Vector3& angularVelocity);
+	void setStress(int index, const Vector6& stress);
+
+	// Advances all blocks by one accepted step; returns the dt taken [s].
+	double step(const IntegratorSettings& settings);
+	const StepStatistics& lastStep() const { return stats_; }
+	double time() const { return time_; }
+	long steps() const { return steps_; }
+	// Half the largest extent of the bounding box of all blocks [m].
+	double sceneHalfSize() const;
+
+private:
+	void validateSettings(const IntegratorSettings& settings) const;
+	std::vector<Block> blocks_;
+	StepStatistics stats_;
+	double nextTimeStep_ = 0;  // dt to try first in the next step; 0 = maxTimeStep
+	double time_ = 0;
+	long steps_ = 0;
+	long displacementLimitMisses_ = 0;
+	// per-step work arrays, kept to avoid reallocation
+	std::vector<int> moving_;
+	std::vector<BlockSystem> systems_;
+	std::vector<Vector12> solutions_, startVelocities_;
+};
+
+}  // namespace dda

@@ -1,0 +1,50 @@
+// The link between a dda::World and the YADE bodies that show its blocks.
+// A YADE Polyhedra body stores its vertices in a local frame (origin at the
+// centroid, axes along the principal axes chosen by YADE when the body was
+// made) and in YADE's own vertex order; this keeps, per block, the body id, the
+// body's orientation at creation and the vertex permutation, so that a sync
+// writes position, orientation and (deformed) local vertices without any search.
+#pragma once
+
+#include "dda/solver/World.hpp"
+
+#include <Eigen/Geometry>
+
+#include <unordered_map>
+#include <vector>
+
+namespace dda {
+
+struct BodyLink {
+	int bodyId = -1;
+	Eigen::Quaterniond orientation0 = Eigen::Quaterniond::Identity();  // body ori at creation
+	std::vector<int> vertexOrder;  // body vertex k is block vertex vertexOrder[k]
+};
+
+class SceneLink {
+public:
+	// Rewrite a body's vertices when the strain accumulated since the last
+	// write exceeds this (relative length change, well above round-off).
+	static constexpr double kVertexSyncStrain = 1e-13;
+
+	World world;
+
+	// Matches the body's local vertices to the block's by position (each within
+	// 1e-9 x block size, else std::invalid_argument).
+	void link(int block, int bodyId, const Eigen::Quaterniond& orientation0, const std::vector<Vector3>& localVertices);
+	const BodyLink* bodyLink(int block) const;
+	int blockOfBody(int bodyId) const;
+	Eigen::Quaterniond bodyOrientation(int block) const;
+	std::vector<Vector3> localVertices(int block) const;
+
+	int blockCount() const { return world.blockCount(); }
+	double sceneHalfSize() const { return world.sceneHalfSize(); }
+	double time() const { return world.time(); }
+	long steps() const { return world.steps(); }
+
+private:
+	std::vector<BodyLink> links_;  // per block; bodyId -1 until linked
+	std::unordered_map<int, int> blockOfBody_;
+};
+
+}  // namespace dda

@@ -1,0 +1,229 @@
+// yade_dda._core: the Boost.Python face of the DDA core.
+//
+// Eigen::Vector3d, Matrix3d and Quaterniond cross the boundary as YADE's own
+// Vector3, Matrix3 and Quaternion: YADE's minieigen registers those converters
+// in Boost.Python's shared registry, so yade must be imported first (the
+// yade_dda package does that). Core exceptions become Python exceptions:
+// dda::InputError (a std::invalid_argument) -> ValueError, std::out_of_range ->
+// IndexError, anything else -> RuntimeError.
+#include "SceneLink.hpp"
+
+#include <boost/python.hpp>
+
+namespace py = boost::python;
+using namespace dda;
+
+namespace {
+
+std::vector<Vector3> toPoints(const py::object& sequence, const char* what) {
+	std::vector<Vector3> points;
+	const long n = py::len(sequence);
+	points.reserve(n);
+	for (long i = 0; i < n; ++i) {
+		py::object item = sequence[i];
+		if (py::len(item) != 3) {
+			PyErr_Format(PyExc_ValueError, "%s: point %ld does not have 3 coordinates", what, i);
+			py::throw_error_already_set();
+		}
+		points.emplace_back(py::extract<double>(item[0])(), py::extract<double>(item[1])(), py::extract<double>(item[2])());
+	}
+	return points;
+}
+
+Vector3 toVector(const py::object& item, const char* what) {
+	if (py::len(item) != 3) {
+		PyErr_Format(PyExc_ValueError, "%s must have 3 components", what);
+		py::throw_error_already_set();
+	}
+	return Vector3(py::extract<double>(item[0])(), py::extract<double>(item[1])(), py::extract<double>(item[2])());
+}
+
+template <class Vector>
+py::tuple toTuple(const Vector& v) {
+	py::list out;
+	for (int i = 0; i < v.size(); ++i) out.append(v(i));
+	return py::tuple(out);
+}
+
+py::list toList(const std::vector<Vector3>& points) {
+	py::list out;
+	for (const Vector3& p : points) out.append(p);
+	return out;
+}
+
+int addBlock(SceneLink& scene, const py::object& points, double density, double young, double poisson, bool fixed) {
+	return scene.world.addBlock(toPoints(points, "block vertices"), Material{density, young, poisson}, fixed);
+}
+
+// Validates a block without adding it (ddaBlock calls this before making a body).
+void checkBlock(const py::object& points, double density, double young, double poisson) {
+	validateMaterial(Material{density, young, poisson});
+	buildConvexPolyhedron(toPoints(points, "block vertices"));
+}
+
+void linkBody(SceneLink& scene, int block, int bodyId, const Eigen::Quaterniond& orientation, const py::object& localVertices) {
+	scene.link(block, bodyId, orientation, toPoints(localVertices, "body vertices"));
+}
+
+py::list blockVertices(const SceneLink& scene, int i) { return toList(scene.world.block(i).vertices); }
+py::list blockFaces(const SceneLink& scene, int i) {
+	py::list faces;
+	for (const auto& face : scene.world.block(i).shape->faces) {
+		py::list f;
+		for (int v : face) f.append(v);
+		faces.append(py::tuple(f));
+	}
+	return faces;
+}
+py::list blockEdges(const SceneLink& scene, int i) {
+	py::list edges;
+	for (const auto& e : scene.world.block(i).shape->edges) edges.append(py::make_tuple(e[0], e[1]));
+	return edges;
+}
+Vector3 blockCentroid(const SceneLink& s, int i) { return s.world.block(i).centroid; }
+double blockVolume(const SceneLink& s, int i) { return s.world.block(i).volume; }
+double blockMass(const SceneLink& s, int i) { return s.world.block(i).mass; }
+Eigen::Matrix3d blockSecondMoment(const SceneLink& s, int i) { return s.world.block(i).secondMoment; }
+py::tuple blockVelocity(const SceneLink& s, int i) { return toTuple(s.world.block(i).velocity); }
+py::tuple blockStress(const SceneLink& s, int i) { return toTuple(s.world.block(i).stress); }
+py::tuple blockStrain(const SceneLink& s, int i) { return toTuple(s.world.block(i).strain); }
+Eigen::Quaterniond blockRotation(const SceneLink& s, int i) { return s.world.block(i).rotation; }
+bool blockFixed(const SceneLink& s, int i) { return s.world.block(i).fixed; }
+py::list blockFixedPoints(const SceneLink& s, int i) {
+	py::list out;
+	for (const FixedPoint& p : s.world.block(i).fixedPoints) out.append(p.position);
+	return out;
+}
+
+void addFixedPoint(SceneLink& s, int i, const py::object& position, double stiffness) {
+	s.world.addFixedPoint(i, toVector(position, "fixed point"), stiffness);
+}
+void addPointLoad(SceneLink& s, int i, const py::object& position, const py::object& force) {
+	s.world.addPointLoad(i, toVector(position, "load position"), toVector(force, "load force"));
+}
+void setVelocity(SceneLink& s, int i, const py::object& v, const py::object& w) {
+	s.world.setVelocity(i, toVector(v, "velocity"), toVector(w, "angular velocity"));
+}
+void setStress(SceneLink& s, int i, const py::object& stress) {
+	if (py::len(stress) != 6) {
+		PyErr_SetString(PyExc_ValueError, "stress must have 6 components (sxx, syy, szz, sxy, syz, szx) in Pa");
+		py::throw_error_already_set();
+	}
+	Vector6 v;
+	for (int k = 0; k < 6; ++k) v(k) = py::extract<double>(stress[k])();
+	s.world.setStress(i, v);
+}
+
+double step(SceneLink& s, const IntegratorSettings& settings) {
+	double dt;
+	{
+		// Release the GIL for the heavy work: nothing in World touches Python.
+		PyThreadState* state = PyEval_SaveThread();
+		try {
+			dt = s.world.step(settings);
+		} catch (...) {
+			PyEval_RestoreThread(state);
+			throw;
+		}
+		PyEval_RestoreThread(state);
+	}
+	return dt;
+}
+
+// Per moving block linked to a body: (bodyId, pos, ori, vel, angVel, vertices or None).
+// Vertices are in the body's local frame, in the body's vertex order, and are
+// sent only when the block's strain changed since the last sync.
+py::list syncData(SceneLink& s, bool all) {
+	py::list out;
+	for (int i = 0; i < s.world.blockCount(); ++i) {
+		Block& b = s.world.block(i);
+		const BodyLink* link = s.bodyLink(i);
+		if (!link || (b.fixed && !all)) continue;
+		const Eigen::Quaterniond ori = s.bodyOrientation(i);
+		py::object vertices;
+		if (all || b.unsyncedStrain > SceneLink::kVertexSyncStrain) {
+			vertices = toList(s.localVertices(i));
+			b.unsyncedStrain = 0;
+		}
+		out.append(py::make_tuple(link->bodyId, b.centroid, ori, Vector3(b.velocity.head<3>()),
+		                          Vector3(b.velocity.segment<3>(3)), vertices));
+	}
+	return out;
+}
+
+py::dict lastStep(const SceneLink& s) {
+	const StepStatistics& st = s.world.lastStep();
+	py::dict d;
+	d["dt"] = st.dt;
+	d["stepCuts"] = st.stepCuts;
+	d["displacementLimitMisses"] = st.displacementLimitMisses;
+	d["maxDisplacement"] = st.maxDisplacement;
+	d["allowedDisplacement"] = st.allowedDisplacement;
+	d["blocks"] = st.blocks;
+	d["movingBlocks"] = st.movingBlocks;
+	d["unknowns"] = st.unknowns;
+	py::dict times;
+	times["assembly"] = st.timeAssembly;
+	times["solve"] = st.timeSolve;
+	times["update"] = st.timeUpdate;
+	times["core"] = st.timeTotal;
+	d["time"] = times;
+	return d;
+}
+
+py::object bodyToBlock(const SceneLink& s, int bodyId) {
+	const int block = s.blockOfBody(bodyId);
+	return block < 0 ? py::object() : py::object(block);
+}
+
+}  // namespace
+
+BOOST_PYTHON_MODULE(_core) {
+	py::docstring_options options(true, true, false);
+
+	py::def("checkBlock", &checkBlock, (py::arg("points"), py::arg("density"), py::arg("young"), py::arg("poisson")),
+	        "Raises ValueError naming the problem if the points and material cannot make a DDA block.");
+
+	py::class_<IntegratorSettings>("IntegratorSettings", "Parameters of one DDA step (see DDAIntegrator for units and meaning).")
+	    .def_readwrite("maxTimeStep", &IntegratorSettings::maxTimeStep)
+	    .def_readwrite("gravity", &IntegratorSettings::gravity)
+	    .def_readwrite("velocityRatio", &IntegratorSettings::velocityRatio)
+	    .def_readwrite("maxDisplacement", &IntegratorSettings::maxDisplacement)
+	    .def_readwrite("maxDisplacementRatio", &IntegratorSettings::maxDisplacementRatio)
+	    .def_readwrite("timeStepSafety", &IntegratorSettings::timeStepSafety)
+	    .def_readwrite("minTimeStepShrink", &IntegratorSettings::minTimeStepShrink)
+	    .def_readwrite("maxTimeStepShrink", &IntegratorSettings::maxTimeStepShrink)
+	    .def_readwrite("timeStepGrowth", &IntegratorSettings::timeStepGrowth)
+	    .def_readwrite("maxStepCuts", &IntegratorSettings::maxStepCuts)
+	    .def_readwrite("fixedPointPenaltyFactor", &IntegratorSettings::fixedPointPenaltyFactor)
+	    .def_readwrite("threads", &IntegratorSettings::threads);
+
+	py::class_<SceneLink, boost::noncopyable>("Scene", "The DDA state of one YADE scene; the core is the source of truth.")
+	    .def("addBlock", &addBlock, (py::arg("points"), py::arg("density"), py::arg("young"), py::arg("poisson"), py::arg("fixed")))
+	    .def("linkBody", &linkBody)
+	    .def("blockOfBody", &bodyToBlock)
+	    .def("blockCount", &SceneLink::blockCount)
+	    .def("vertices", &blockVertices)
+	    .def("faces", &blockFaces)
+	    .def("edges", &blockEdges)
+	    .def("centroid", &blockCentroid)
+	    .def("volume", &blockVolume)
+	    .def("mass", &blockMass)
+	    .def("secondMoment", &blockSecondMoment)
+	    .def("velocity", &blockVelocity)
+	    .def("stress", &blockStress)
+	    .def("strain", &blockStrain)
+	    .def("rotation", &blockRotation)
+	    .def("isFixed", &blockFixed)
+	    .def("fixedPoints", &blockFixedPoints)
+	    .def("addFixedPoint", &addFixedPoint)
+	    .def("addPointLoad", &addPointLoad)
+	    .def("setVelocity", &setVelocity)
+	    .def("setStress", &setStress)
+	    .def("step", &step)
+	    .def("syncData", &syncData)
+	    .def("lastStep", &lastStep)
+	    .def("sceneHalfSize", &SceneLink::sceneHalfSize)
+	    .def("time", &SceneLink::time)
+	    .def("steps", &SceneLink::steps);
+}

@@ -1,0 +1,142 @@
+"""Making DDA blocks: YADE bodies with a Polyhedra shape, backed by the DDA core."""
+import math
+
+from ._yade import O, utils, wrapper
+from . import _core
+from . import scene as _scene
+
+
+class BlockSpec:
+    """What the core needs to build a block once its body is in O.bodies."""
+
+    __slots__ = ('points', 'density', 'young', 'poisson', 'fixed', 'fixedPoints', 'loads', 'stress')
+
+    def __init__(self, **kw):
+        for key in self.__slots__:
+            setattr(self, key, kw.get(key))
+
+
+def _vector(value, what, length=3):
+    try:
+        values = [float(x) for x in value]
+    except TypeError:
+        raise TypeError('%s must be a sequence of %d numbers, got %r' % (what, length, value)) from None
+    if len(values) != length:
+        raise ValueError('%s must have %d components, got %d' % (what, length, len(values)))
+    for i, x in enumerate(values):
+        if not math.isfinite(x):
+            raise ValueError('%s has a non-finite component %d: %r' % (what, i, x))
+    return tuple(values)
+
+
+def _points(vertices):
+    try:
+        items = list(vertices)
+    except TypeError:
+        raise TypeError('vertices must be a sequence of points, got %r' % (vertices,)) from None
+    points = []
+    for i, p in enumerate(items):
+        try:
+            coords = [float(x) for x in p]
+        except TypeError:
+            raise TypeError('point %d must be a sequence of 3 numbers, got %r' % (i, p)) from None
+        if len(coords) != 3:
+            raise ValueError('point %d must have 3 coordinates, got %d' % (i, len(coords)))
+        points.append(tuple(coords))
+    return points
+
+
+def _material(material):
+    """Resolves YADE's ways of naming a material: None (default), id, label or instance."""
+    if material is None:
+        return wrapper.PolyhedraMat()
+    if isinstance(material, int):
+        if not 0 <= material < len(O.materials) and not -len(O.materials) <= material < 0:
+            raise IndexError('no material with id %d (O.materials has %d)' % (material, len(O.materials)))
+        return O.materials[material]
+    if isinstance(material, str):
+        for m in O.materials:
+            if m.label == material:
+                return m
+        raise KeyError('no material labelled %r in O.materials' % material)
+    if callable(material) and not isinstance(material, wrapper.Material):
+        return _material(material())
+    if not isinstance(material, wrapper.Material):
+        raise TypeError('material must be a YADE Material, its id or its label, got %r' % (material,))
+    return material
+
+
+def _elasticConstants(material):
+    missing = [name for name in ('density', 'young', 'poisson') if not hasattr(material, name)]
+    if missing:
+        raise TypeError('material %s has no %s; use PolyhedraMat (or another elastic material)'
+                        % (type(material).__name__, ', '.join(missing)))
+    return float(material.density), float(material.young), float(material.poisson)
+
+
+def ddaBlock(vertices, material=None, fixed=False, color=None, velocity=(0, 0, 0),
+             angularVelocity=(0, 0, 0), fixedPoints=(), loads=(), stress=None, mask=1, wire=False):
+    """A DDA block as a YADE Body, ready for ``O.bodies.append``.
+
+    The block is the convex polyhedron whose corners are ``vertices`` [m]
+    (every point must be a corner). Its volume, centroid and second moments are
+    exact integrals; the body's mass and inertia follow from them and the
+    material's density. The body carries a ``Polyhedra`` shape, so YADE's GUI,
+    VTK export and ``O.bodies`` see it like any polyhedron.
+
+    :param vertices: corner points [m], at least 4, not coplanar.
+    :param material: a ``PolyhedraMat`` (or other elastic material with
+        ``young`` [Pa], ``poisson`` and ``density`` [kg/m^3]), its id in
+        ``O.materials`` or its label; None makes a default ``PolyhedraMat``.
+    :param fixed: a fixed block never moves and has no unknowns.
+    :param velocity: initial velocity of the centroid [m/s].
+    :param angularVelocity: initial angular velocity [rad/s].
+    :param fixedPoints: material points [m] held by penalty springs; each entry
+        a point, or ``(point, stiffness)`` with stiffness in N/m (0 = default,
+        see ``DDAIntegrator.fixedPointPenaltyFactor``).
+    :param loads: ``(point, force)`` pairs: constant forces [N] at material points [m].
+    :param stress: initial stress (sxx, syy, szz, sxy, syz, szx) [Pa].
+    :param mask: YADE groupMask of the body.
+
+    Raises ValueError naming the problem for bad geometry (fewer than 4 points,
+    coplanar, duplicated, NaN/inf, a point that is not a corner of the hull),
+    bad material constants, or non-finite vectors; nothing is added then.
+
+    Example::
+
+        b = O.bodies.append(ddaBlock([(0,0,0),(1,0,0),(0,1,0),(1,1,0),(0,0,1),(1,0,1),(0,1,1),(1,1,1)],
+                                     material=mat, velocity=(1, 0, 0)))
+    """
+    points = _points(vertices)
+    mat = _material(material)
+    density, young, poisson = _elasticConstants(mat)
+    _core.checkBlock(points, density, young, poisson)
+    velocity = _vector(velocity, 'velocity')
+    angularVelocity = _vector(angularVelocity, 'angularVelocity')
+    if fixed and (any(velocity) or any(angularVelocity)):
+        raise ValueError('a fixed block cannot have an initial velocity')
+    fixedList = []
+    for i, entry in enumerate(fixedPoints):
+        if len(entry) == 2 and not isinstance(entry[0], (int, float)):
+            point, stiffness = entry
+        else:
+            point, stiffness = entry, 0.0
+        point = _vector(point, 'fixed point %d' % i)
+        stiffness = float(stiffness)
+        if not (math.isfinite(stiffness) and stiffness >= 0):
+            raise ValueError('fixed point %d: stiffness must be >= 0 N/m, got %r' % (i, stiffness))
+        fixedList.append((point, stiffness))
+    loadList = [(_vector(p, 'load %d point' % i), _vector(f, 'load %d force' % i)) for i, (p, f) in enumerate(loads)]
+    if stress is not None:
+        stress = _vector(stress, 'stress', 6)
+    if not isinstance(mask, int):
+        raise TypeError('mask must be an int, got %r' % (mask,))
+
+    body = utils.polyhedron(points, fixed=fixed, wire=wire, color=color, material=mat, mask=mask)
+    if not fixed:
+        body.state.vel = velocity
+        body.state.angVel = angularVelocity
+    spec = BlockSpec(points=points, density=density, young=young, poisson=poisson, fixed=bool(fixed),
+                     fixedPoints=fixedList, loads=loadList, stress=stress)
+    _scene.current().register(body, spec)
+    return body

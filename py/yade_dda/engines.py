@@ -1,0 +1,214 @@
+"""YADE engines of yade-dda.
+
+YADE runs Python from engines only through ``PyRunner``; each engine here is a
+``PyRunner`` subclass whose command calls the compiled core once per step.
+The command string carries every parameter, so an engine that comes back from
+``O.save()``/``O.load()`` as a plain PyRunner still knows its settings.
+"""
+import math
+import sys
+import time
+
+from ._yade import O, wrapper
+from . import _core
+from . import scene as _scene
+
+
+def _finite(name, value, low=None, high=None, lowOpen=False, unit=''):
+    value = float(value)
+    ok = math.isfinite(value)
+    if ok and low is not None:
+        ok = value > low if lowOpen else value >= low
+    if ok and high is not None:
+        ok = value <= high
+    if not ok:
+        bounds = '%s%s, %s]' % ('(' if lowOpen else '[', low, high if high is not None else 'inf')
+        raise ValueError('%s must be finite and in %s, got %r%s' % (name, bounds, value, unit))
+    return value
+
+
+class _Parameter:
+    """A typed engine parameter: default, unit, validation; stored in the command."""
+
+    def __init__(self, default, check, doc):
+        self.default, self.check, self.__doc__ = default, check, doc
+
+    def __set_name__(self, owner, name):
+        self.name = name
+
+    def __get__(self, engine, owner=None):
+        if engine is None:
+            return self
+        return engine._params[self.name]
+
+    def __set__(self, engine, value):
+        engine._params[self.name] = self.check(value)
+        engine._updateCommand()
+
+
+def _vector3(name):
+    def check(value):
+        values = tuple(float(x) for x in value)
+        if len(values) != 3 or not all(math.isfinite(x) for x in values):
+            raise ValueError('%s must be 3 finite numbers, got %r' % (name, value))
+        return values
+    return check
+
+
+class DDAIntegrator(wrapper.PyRunner):
+    """Shi's implicit DDA time integration of all DDA blocks (replaces NewtonIntegrator).
+
+    Each step solves, for the 12 unknowns D of every moving block
+    (translation, rotation, strain; Wu et al. 2014 Eq. 1-6),
+    ``K D = F`` with inertia ``(2/dt^2) M D = (2/dt) M v0`` (constant
+    acceleration over the step), elastic stiffness ``V E``, the stress of the
+    previous step, gravity, fixed-point penalty springs and point loads; then
+    moves each block by an exact rotation about its centroid followed by the
+    strain, sets ``v1 = 2 D / dt - v0`` and adds ``E * strain`` to the stress.
+    A step whose largest vertex displacement exceeds the allowed one is redone
+    with a smaller dt. ``O.dt`` and ``O.time`` follow the step actually taken.
+
+    Parameters (SI units):
+
+    - ``dt`` [s]: largest time step, > 0.
+    - ``gravity`` [m/s^2]: body acceleration.
+    - ``velocityRatio`` [-]: Shi's dynamic coefficient in [0, 1]; 1 is fully
+      dynamic, 0 static analysis (velocities reset every step).
+    - ``maxDisplacement`` [m]: largest vertex displacement per step; 0 means
+      ``maxDisplacementRatio`` x half the largest extent of the scene.
+    - ``maxDisplacementRatio`` [-]: Shi's g2, default 0.01.
+    - ``timeStepGrowth`` [-]: after an accepted step the next one tries dt x this.
+    - ``maxStepCuts``: redos allowed per step before a step is accepted anyway
+      (counted in ``stats()['displacementLimitMisses']``).
+    - ``fixedPointPenaltyFactor`` [-]: default fixed-point stiffness is this x E x
+      block size (cube root of the volume).
+    - ``threads``: worker threads for the core, 0 = all; results do not depend on it.
+    - ``syncPeriod``: write the DDA state into YADE's bodies every n steps; 0
+      (default) = when something may read it: the last step of ``O.run(n)``,
+      ``O.step()``, a step after which another periodic engine (a PyRunner
+      recorder, VTK export, ...) is due, or an open GUI view.
+
+    Example::
+
+        O.engines = [DDAIntegrator(dt=1e-3, gravity=(0, 0, -9.81), label='dda')]
+        O.run(1000, True)
+    """
+
+    dt = _Parameter(1e-3, lambda v: _finite('dt', v, 0, lowOpen=True, unit=' s'), 'largest time step [s]')
+    gravity = _Parameter((0.0, 0.0, 0.0), _vector3('gravity'), 'body acceleration [m/s^2]')
+    velocityRatio = _Parameter(1.0, lambda v: _finite('velocityRatio', v, 0, 1), "Shi's dynamic coefficient [-]")
+    maxDisplacement = _Parameter(0.0, lambda v: _finite('maxDisplacement', v, 0, unit=' m'),
+                                 'largest vertex displacement per step [m]; 0 = use maxDisplacementRatio')
+    maxDisplacementRatio = _Parameter(0.01, lambda v: _finite('maxDisplacementRatio', v, 0, 1, lowOpen=True),
+                                      'allowed displacement / half scene size [-]')
+    timeStepGrowth = _Parameter(1.3, lambda v: _finite('timeStepGrowth', v, 1), 'dt growth after a step [-]')
+    maxStepCuts = _Parameter(30, lambda v: int(_finite('maxStepCuts', v, 0)), 'redos allowed per step')
+    fixedPointPenaltyFactor = _Parameter(1000.0, lambda v: _finite('fixedPointPenaltyFactor', v, 0, lowOpen=True),
+                                         'default fixed-point stiffness / (E x block size) [-]')
+    threads = _Parameter(0, lambda v: int(_finite('threads', v, 0)), 'core threads, 0 = all')
+    syncPeriod = _Parameter(0, lambda v: int(_finite('syncPeriod', v, 0)), 'steps between syncs, 0 = automatic')
+
+    _names = ('dt', 'gravity', 'velocityRatio', 'maxDisplacement', 'maxDisplacementRatio', 'timeStepGrowth',
+              'maxStepCuts', 'fixedPointPenaltyFactor', 'threads', 'syncPeriod')
+
+    def __init__(self, label='', **params):
+        wrapper.PyRunner.__init__(self)
+        unknown = set(params) - set(self._names)
+        if unknown:
+            raise TypeError('DDAIntegrator has no parameter %s (parameters: %s)'
+                            % (', '.join(sorted(unknown)), ', '.join(self._names)))
+        self._params = {}
+        for name in self._names:
+            descriptor = type(self).__dict__[name]
+            self._params[name] = descriptor.check(params.get(name, descriptor.default))
+        self.iterPeriod = 1
+        self.initRun = True
+        if label:
+            self.label = label
+        self._updateCommand()
+
+    def _updateCommand(self):
+        self.command = 'import yade_dda.engines as _dda; _dda.integratorStep(%r)' % (self._params,)
+
+
+_settingsCache = {}
+
+
+def _settings(params):
+    key = repr(params)
+    settings = _settingsCache.get(key)
+    if settings is None:
+        settings = _core.IntegratorSettings()
+        settings.maxTimeStep = params['dt']
+        settings.gravity = params['gravity']
+        settings.velocityRatio = params['velocityRatio']
+        settings.maxDisplacement = params['maxDisplacement']
+        settings.maxDisplacementRatio = params['maxDisplacementRatio']
+        settings.timeStepGrowth = params['timeStepGrowth']
+        settings.maxStepCuts = params['maxStepCuts']
+        settings.fixedPointPenaltyFactor = params['fixedPointPenaltyFactor']
+        settings.threads = params['threads']
+        _settingsCache[key] = settings
+    return settings
+
+
+def _readerDue(engine):
+    """True when a periodic engine other than ours may run before our next step."""
+    if engine.dead:
+        return False
+    if engine.iterPeriod > 0 and O.iter + 1 - engine.iterLast >= engine.iterPeriod:
+        return True
+    if engine.virtPeriod > 0 and O.time + O.dt - engine.virtLast >= engine.virtPeriod:
+        return True
+    if engine.realPeriod > 0 and time.time() - engine.realLast >= 0.9 * engine.realPeriod:
+        return True
+    return False
+
+
+def _guiOpen():
+    qt = sys.modules.get('yade.qt')
+    return qt is not None and len(qt.views()) > 0
+
+
+def _syncNeeded(params, engines):
+    period = params['syncPeriod']
+    if period > 0:
+        return (O.iter + 1) % period == 0 or O.iter + 1 == O.stopAtIter
+    if not O.running or O.iter + 1 >= O.stopAtIter > 0:
+        return True
+    for engine in engines:
+        if isinstance(engine, wrapper.PeriodicEngine) and not _isOwnCommand(engine) and _readerDue(engine):
+            return True
+    return _guiOpen()
+
+
+def _isOwnCommand(engine):
+    return isinstance(engine, wrapper.PyRunner) and engine.command.startswith('import yade_dda.')
+
+
+def _checkEngines(scene, engines):
+    """Refuses engine lists that would move DDA blocks twice."""
+    for engine in engines:
+        if isinstance(engine, wrapper.NewtonIntegrator):
+            for index, bodyId in enumerate(scene.bodyOfBlock):
+                body = O.bodies[bodyId]
+                if body is not None and body.dynamic and (engine.mask & body.groupMask):
+                    raise RuntimeError(
+                        'NewtonIntegrator would also move DDA block body %d (its groupMask %d overlaps '
+                        'NewtonIntegrator.mask %d). Give DDA blocks their own mask bit, e.g. '
+                        'ddaBlock(..., mask=2) and NewtonIntegrator(mask=1), so YADE moves only its own bodies.'
+                        % (bodyId, body.groupMask, engine.mask))
+
+
+def integratorStep(params):
+    """One DDA step; called by DDAIntegrator's command every iteration."""
+    scene = _scene.current()
+    before = len(scene.bodyOfBlock)
+    scene.resolvePending()
+    engines = O.engines
+    if len(scene.bodyOfBlock) != before or scene.checkedEngines != len(engines):
+        _checkEngines(scene, engines)
+        scene.checkedEngines = len(engines)
+    O.dt = scene.core.step(_settings(params))
+    if _syncNeeded(params, engines):
+        scene.sync()

@@ -1,0 +1,226 @@
+"""The DDA state of the current YADE scene, and its link to YADE's bodies.
+
+The compiled core (``yade_dda._core.Scene``) is the source of truth for every
+DDA block: geometry, 12-unknown velocity, stress. YADE bodies show that state;
+``sync`` writes it into them (position, orientation, velocity, angular
+velocity and, for strained blocks, the local vertices of the Polyhedra shape).
+
+One core scene belongs to one YADE scene. It is found through a token stored in
+``O.tags``, so ``O.reset()`` (which clears the tags) starts a fresh DDA scene.
+"""
+import time
+import uuid
+
+from ._yade import O
+from . import _core
+
+TAG = 'yade_dda.scene'
+_scenes = {}
+
+
+class DDAScene:
+    """Core scene plus the bookkeeping between blocks and YADE bodies."""
+
+    def __init__(self, token):
+        self.token = token
+        self.core = _core.Scene()
+        self.pending = []          # [(body, BlockSpec)] made by ddaBlock, not yet in the core
+        self.bodyOfBlock = []      # block index -> body id
+        self.syncTime = 0.0        # wall time of the last sync [s]
+        self.syncedBodies = 0
+        self.syncs = 0             # number of syncs done
+        self.lastSyncIter = -1
+        self.checkedEngines = None  # engine list last checked for conflicts
+
+    def register(self, body, spec):
+        self.pending.append((body, spec))
+
+    def resolvePending(self):
+        """Moves blocks whose bodies are now in O.bodies into the core."""
+        if not self.pending:
+            return
+        waiting = []
+        for body, spec in self.pending:
+            if body.id < 0:
+                waiting.append((body, spec))   # made but not (yet) appended: not simulated
+                continue
+            index = self.core.addBlock(spec.points, spec.density, spec.young, spec.poisson, spec.fixed)
+            self.core.linkBody(index, body.id, body.state.ori, list(body.shape.v))
+            # The body's state is read here, so a script may still set
+            # b.state.vel / b.state.angVel between ddaBlock() and the first step.
+            if not spec.fixed:
+                self.core.setVelocity(index, body.state.vel, body.state.angVel)
+            for point, stiffness in spec.fixedPoints:
+                self.core.addFixedPoint(index, point, stiffness)
+            for point, force in spec.loads:
+                self.core.addPointLoad(index, point, force)
+            if spec.stress is not None:
+                self.core.setStress(index, spec.stress)
+            assert index == len(self.bodyOfBlock)
+            self.bodyOfBlock.append(body.id)
+        self.pending = waiting
+
+    def blockIndex(self, body):
+        """Block index of a body (a Body or an id); raises for non-DDA bodies."""
+        bodyId = body if isinstance(body, int) else body.id
+        self.resolvePending()
+        index = self.core.blockOfBody(bodyId)
+        if index is None:
+            raise KeyError('body %d is not a DDA block (unknown body id, or not yet appended to O.bodies)' % bodyId)
+        return index
+
+    def sync(self, everything=False):
+        """Writes the core state of moving blocks (all blocks if everything) into YADE's bodies."""
+        start = time.perf_counter()
+        bodies = O.bodies
+        data = self.core.syncData(everything)
+        for bodyId, pos, ori, vel, angVel, vertices in data:
+            body = bodies[bodyId]
+            if body is None:
+                raise RuntimeError('body %d of a DDA block was removed from O.bodies; '
+                                   'removing DDA blocks mid-run is not supported' % bodyId)
+            state = body.state
+            state.pos = pos
+            state.ori = ori
+            state.vel = vel
+            state.angVel = angVel
+            if vertices is not None:
+                body.shape.v = vertices
+        self.syncTime = time.perf_counter() - start
+        self.syncedBodies = len(data)
+        self.syncs += 1
+        self.lastSyncIter = O.iter
+
+
+def current(create=True):
+    """The DDA scene of the current YADE scene (made on demand when create)."""
+    try:
+        token = O.tags[TAG]
+    except KeyError:
+        token = None
+    if token is not None and token in _scenes:
+        return _scenes[token]
+    if token is not None:
+        raise RuntimeError('this YADE scene holds DDA state from another session (loaded from a file?); '
+                           'restoring DDA blocks with O.load() is not supported yet')
+    if not create:
+        return None
+    token = uuid.uuid4().hex
+    O.tags[TAG] = token
+    scene = _scenes[token] = DDAScene(token)
+    return scene
+
+
+def _require():
+    scene = current(create=False)
+    if scene is None:
+        raise RuntimeError('this YADE scene has no DDA blocks (make them with ddaBlock)')
+    return scene
+
+
+def sync(everything=True):
+    """Writes the DDA state into the YADE bodies now (normally automatic, see DDAIntegrator.syncPeriod)."""
+    scene = current(create=False)
+    if scene is not None:
+        scene.resolvePending()
+        scene.sync(everything)
+
+
+def stats():
+    """Diagnostics of the last DDA step as a dict.
+
+    Keys: ``dt`` [s] taken, ``stepCuts`` (redos with a smaller dt in that step),
+    ``displacementLimitMisses`` (cumulative steps accepted above the bound),
+    ``maxDisplacement`` and ``allowedDisplacement`` [m], ``blocks``,
+    ``movingBlocks``, ``unknowns`` (system size), ``time`` (wall seconds per
+    phase: assembly, solve, update, core, sync), ``syncedBodies``, ``syncs``.
+    """
+    scene = _require()
+    result = scene.core.lastStep()
+    result['time']['sync'] = scene.syncTime
+    result['syncedBodies'] = scene.syncedBodies
+    result['syncs'] = scene.syncs
+    result['pendingBodies'] = sum(1 for body, _ in scene.pending if body.id >= 0)
+    result['steps'] = scene.core.steps()
+    return result
+
+
+def printStats():
+    """Prints the last step's diagnostics as a table."""
+    s = stats()
+    print('DDA step: dt %.3e s, %d cuts, %d/%d moving blocks, %d unknowns, max displacement %.3e m (allowed %.3e m)'
+          % (s['dt'], s['stepCuts'], s['movingBlocks'], s['blocks'], s['unknowns'], s['maxDisplacement'],
+             s['allowedDisplacement']))
+    for phase in ('assembly', 'solve', 'update', 'core', 'sync'):
+        print('  %-9s %10.3f ms' % (phase, 1e3 * s['time'][phase]))
+
+
+class BlockView:
+    """Read-only view of one block's core state (SI units)."""
+
+    def __init__(self, scene, index):
+        self._core, self.index = scene.core, index
+
+    vertices = property(lambda self: self._core.vertices(self.index), doc='current vertices [m]')
+    faces = property(lambda self: self._core.faces(self.index), doc='faces as vertex-index tuples, CCW from outside')
+    edges = property(lambda self: self._core.edges(self.index), doc='edges as vertex-index pairs')
+    centroid = property(lambda self: self._core.centroid(self.index), doc='centroid [m]')
+    volume = property(lambda self: self._core.volume(self.index), doc='volume [m^3]')
+    mass = property(lambda self: self._core.mass(self.index), doc='mass [kg] (conserved)')
+    secondMoment = property(lambda self: self._core.secondMoment(self.index),
+                            doc='integral of (x-c)(x-c)^T dV [m^5]')
+    velocity = property(lambda self: self._core.velocity(self.index),
+                        doc='rates of the 12 unknowns: (vx, vy, vz, wx, wy, wz, exx, eyy, ezz, gxy, gyz, gzx)')
+    stress = property(lambda self: self._core.stress(self.index), doc='(sxx, syy, szz, sxy, syz, szx) [Pa]')
+    strain = property(lambda self: self._core.strain(self.index), doc='accumulated (ex, ey, ez, gxy, gyz, gzx) [-]')
+    rotation = property(lambda self: self._core.rotation(self.index), doc='rotation since creation (Quaternion)')
+    fixed = property(lambda self: self._core.isFixed(self.index))
+    fixedPoints = property(lambda self: self._core.fixedPoints(self.index), doc='current fixed-point positions [m]')
+
+
+def block(body):
+    """The core state of a DDA body (a Body or its id) as a BlockView."""
+    scene = _require()
+    return BlockView(scene, scene.blockIndex(body))
+
+
+def blockOf(body):
+    """Block index of a DDA body, or None for a body that is not a DDA block."""
+    scene = current(create=False)
+    if scene is None:
+        return None
+    bodyId = body if isinstance(body, int) else body.id
+    scene.resolvePending()
+    return scene.core.blockOfBody(bodyId)
+
+
+def setVelocity(body, velocity=(0, 0, 0), angularVelocity=(0, 0, 0)):
+    """Sets a block's velocity [m/s] and angular velocity [rad/s]; strain rates become zero."""
+    scene = _require()
+    index = scene.blockIndex(body)
+    scene.core.setVelocity(index, velocity, angularVelocity)
+
+
+def addPointLoad(body, point, force):
+    """Adds a constant force [N] at a material point [m] of a block."""
+    scene = _require()
+    scene.core.addPointLoad(scene.blockIndex(body), point, force)
+
+
+def addFixedPoint(body, point, stiffness=0):
+    """Holds the material point now at point [m] with a penalty spring [N/m] (0: default)."""
+    scene = _require()
+    scene.core.addFixedPoint(scene.blockIndex(body), point, stiffness)
+
+
+def dataFor(bodies=None):
+    """Positions [m] and velocities [m/s] of DDA bodies straight from the core, without a sync."""
+    scene = _require()
+    scene.resolvePending()
+    ids = bodies if bodies is not None else scene.bodyOfBlock
+    out = {}
+    for bodyId in ids:
+        index = scene.blockIndex(bodyId)
+        v = scene.core.velocity(index)
+        out[bodyId] = (scene.core.centroid(index), v[:3])
+    return out
