@@ -37,6 +37,10 @@ const BodyLink* SceneLink::bodyLink(int blockIndex) const {
 	return &links_[blockIndex];
 }
 
+BodyLink* SceneLink::bodyLink(int blockIndex) {
+	return const_cast<BodyLink*>(static_cast<const SceneLink*>(this)->bodyLink(blockIndex));
+}
+
 int SceneLink::blockOfBody(int bodyId) const {
 	const auto found = blockOfBody_.find(bodyId);
 	return found == blockOfBody_.end() ? -1 : found->second;

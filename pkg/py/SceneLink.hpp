@@ -19,6 +19,7 @@ struct BodyLink {
 	int bodyId = -1;
 	Eigen::Quaterniond orientation0 = Eigen::Quaterniond::Identity();  // body ori at creation
 	std::vector<int> vertexOrder;  // body vertex k is block vertex vertexOrder[k]
+	bool synced = false;           // written at least once (fixed blocks need only that)
 };
 
 class SceneLink {
@@ -33,12 +34,13 @@ public:
 	// 1e-9 x block size, else std::invalid_argument).
 	void link(int block, int bodyId, const Eigen::Quaterniond& orientation0, const std::vector<Vector3>& localVertices);
 	const BodyLink* bodyLink(int block) const;
+	BodyLink* bodyLink(int block);
 	int blockOfBody(int bodyId) const;
 	Eigen::Quaterniond bodyOrientation(int block) const;
 	std::vector<Vector3> localVertices(int block) const;
 
 	int blockCount() const { return world.blockCount(); }
-	double sceneHalfSize() const { return world.sceneHalfSize(); }
+	double sceneHalfSize() { return world.sceneHalfSize(); }
 	double time() const { return world.time(); }
 	long steps() const { return world.steps(); }
 

@@ -130,15 +130,16 @@ double step(SceneLink& s, const IntegratorSettings& settings) {
 	return dt;
 }
 
-// Per moving block linked to a body: (bodyId, pos, ori, vel, angVel, vertices or None).
+// Per moving block linked to a body (and fixed ones once): (bodyId, pos, ori, vel, angVel, vertices or None).
 // Vertices are in the body's local frame, in the body's vertex order, and are
 // sent only when the block's strain changed since the last sync.
 py::list syncData(SceneLink& s, bool all) {
 	py::list out;
 	for (int i = 0; i < s.world.blockCount(); ++i) {
 		Block& b = s.world.block(i);
-		const BodyLink* link = s.bodyLink(i);
-		if (!link || (b.fixed && !all)) continue;
+		BodyLink* link = s.bodyLink(i);
+		if (!link || (b.fixed && link->synced && !all)) continue;
+		link->synced = true;
 		const Eigen::Quaterniond ori = s.bodyOrientation(i);
 		py::object vertices;
 		if (all || b.unsyncedStrain > SceneLink::kVertexSyncStrain) {

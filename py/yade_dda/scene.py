@@ -29,6 +29,7 @@ class DDAScene:
         self.syncTime = 0.0        # wall time of the last sync [s]
         self.syncedBodies = 0
         self.syncs = 0             # number of syncs done
+        self.syncTimeTotal = 0.0   # wall time of all syncs [s]
         self.lastSyncIter = -1
         self.checkedEngines = None  # engine list last checked for conflicts
 
@@ -87,6 +88,7 @@ class DDAScene:
             if vertices is not None:
                 body.shape.v = vertices
         self.syncTime = time.perf_counter() - start
+        self.syncTimeTotal += self.syncTime
         self.syncedBodies = len(data)
         self.syncs += 1
         self.lastSyncIter = O.iter
@@ -133,13 +135,15 @@ def stats():
     ``displacementLimitMisses`` (cumulative steps accepted above the bound),
     ``maxDisplacement`` and ``allowedDisplacement`` [m], ``blocks``,
     ``movingBlocks``, ``unknowns`` (system size), ``time`` (wall seconds per
-    phase: assembly, solve, update, core, sync), ``syncedBodies``, ``syncs``.
+    phase: assembly, solve, update, core, sync), ``syncedBodies`` and ``syncs``
+    (bodies written by the last sync, syncs so far), ``syncTimeTotal`` [s].
     """
     scene = _require()
     result = scene.core.lastStep()
     result['time']['sync'] = scene.syncTime
     result['syncedBodies'] = scene.syncedBodies
     result['syncs'] = scene.syncs
+    result['syncTimeTotal'] = scene.syncTimeTotal
     result['pendingBodies'] = sum(1 for body, _ in scene.pending if body.id >= 0)
     result['steps'] = scene.core.steps()
     return result

@@ -89,12 +89,58 @@ std::vector<Vector3> ellipsoidPoints(int count, const Vector3& semiAxes, const V
 	return points;
 }
 
-Matrix3 rotation(double angle, const Vector3& axis) { return Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix(); }
+Matrix3 rotation(double angle, const Vector3& axis) {
+	return Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix();
+}
+
+// Uniform numbers in [0, 1) from the raw mt19937 stream (portable across
+// standard libraries, unlike std::uniform_real_distribution).
+class Uniform {
+public:
+	explicit Uniform(unsigned seed) : engine_(seed) {}
+	double operator()() { return engine_() / 4294967296.0; }
+	double in(double lo, double hi) { return lo + (hi - lo) * (*this)(); }
+	Vector3 in(const Vector3& lo, const Vector3& hi) {
+		const double x = in(lo.x(), hi.x()), y = in(lo.y(), hi.y()), z = in(lo.z(), hi.z());
+		return {x, y, z};
+	}
+
+private:
+	std::mt19937 engine_;
+};
+
+// A rotation uniformly distributed over SO(3) (Shoemake's unit quaternion).
+Matrix3 randomRotation(Uniform& uniform) {
+	const double u1 = uniform(), a = 2 * kPi * uniform(), b = 2 * kPi * uniform();
+	const Eigen::Quaterniond q(std::sqrt(1 - u1) * std::sin(a), std::sqrt(1 - u1) * std::cos(a),
+	                           std::sqrt(u1) * std::sin(b), std::sqrt(u1) * std::cos(b));
+	return q.normalized().toRotationMatrix();
+}
+
+// `count` points spread evenly over a sphere (Fibonacci lattice): a strictly
+// convex surface, finely but irregularly tessellated by its hull.
+std::vector<Vector3> fibonacciSphere(int count, double radius, const Vector3& center) {
+	const double goldenAngle = kPi * (3 - std::sqrt(5.0));
+	std::vector<Vector3> points;
+	for (int i = 0; i < count; ++i) {
+		const double z = 1 - (2 * i + 1.0) / count;
+		const double r = std::sqrt(1 - z * z);
+		points.push_back(center + radius * Vector3(r * std::cos(goldenAngle * i), r * std::sin(goldenAngle * i), z));
+	}
+	return points;
+}
 
 std::vector<Vector3> moved(const std::vector<Vector3>& points, const Matrix3& R, const Vector3& t) {
 	std::vector<Vector3> result;
 	for (const Vector3& p : points) result.push_back(R * p + t);
 	return result;
+}
+
+// A box of the given size centred at `center`, rotated by R about its centre;
+// the corners are rounded to double, so its sides are generally not exactly
+// planar any more.
+std::vector<Vector3> rotatedBox(const Vector3& size, const Matrix3& R, const Vector3& center) {
+	return moved(boxCorners(-size / 2, size), R, center);
 }
 
 double boundingDiagonal(const std::vector<Vector3>& points) {
@@ -106,7 +152,9 @@ double boundingDiagonal(const std::vector<Vector3>& points) {
 	return (hi - lo).norm();
 }
 
-double relativeError(const Matrix3& actual, const Matrix3& expected) { return (actual - expected).norm() / expected.norm(); }
+double relativeError(const Matrix3& actual, const Matrix3& expected) {
+	return (actual - expected).norm() / expected.norm();
+}
 
 double relativeError(double actual, double expected) { return std::abs(actual - expected) / std::abs(expected); }
 
@@ -187,21 +235,36 @@ Matrix3 boxSecondMoment(const Vector3& size) {
 
 Point3 toPoint3(const Vector3& p) { return Point3(p.x(), p.y(), p.z()); }
 
-// Newell's method: twice the vector area of the polygon.
+// Newell's method: twice the vector area of the polygon, taken about the mean
+// of its corners (round-off stays relative to the block, not to the distance
+// from the origin).
 Vector3 newellNormal(const ConvexPolyhedron& poly, const std::vector<int>& face) {
+	Vector3 mean = Vector3::Zero();
+	for (int v : face) mean += poly.vertices[v];
+	mean /= static_cast<double>(face.size());
 	Vector3 n = Vector3::Zero();
 	for (std::size_t k = 0; k < face.size(); ++k) {
-		const Vector3& p = poly.vertices[face[k]];
-		const Vector3& q = poly.vertices[face[(k + 1) % face.size()]];
+		const Vector3 p = poly.vertices[face[k]] - mean;
+		const Vector3 q = poly.vertices[face[(k + 1) % face.size()]] - mean;
 		n += p.cross(q);
 	}
 	return n;
 }
 
+// The distance within which the library treats points as on one face plane.
+double coplanarTolerance(const std::vector<Vector3>& points) {
+	return dda::kCoplanarRelativeTolerance * boundingDiagonal(points);
+}
+
 // Everything the header promises about a polyhedron built from `points`.
+// Faces are checked as the header tells consumers to read them: the plane
+// through the mean of the corners with the Newell normal. A face's corners
+// must lie within the coplanar tolerance of it, every other vertex strictly
+// behind it by more than that.
 void expectValidPolyhedron(const ConvexPolyhedron& poly, const std::vector<Vector3>& points) {
 	ASSERT_EQ(poly.vertices, points) << "vertices must be the input points, in input order";
 	const int vertexCount = static_cast<int>(points.size());
+	const double tolerance = coplanarTolerance(points);
 
 	Vector3 inner = Vector3::Zero();  // vertex mean: inside a convex body
 	for (const Vector3& p : points) inner += p;
@@ -218,26 +281,35 @@ void expectValidPolyhedron(const ConvexPolyhedron& poly, const std::vector<Vecto
 			++facesAtVertex[v];
 		}
 
-		const Point3 a = toPoint3(points[face[0]]), b = toPoint3(points[face[1]]), c = toPoint3(points[face[2]]);
 		const Vector3 normal = newellNormal(poly, face);
+		const Vector3 unitNormal = normal.normalized();
+		Vector3 mean = Vector3::Zero();
+		for (int v : face) mean += points[v];
+		mean /= static_cast<double>(face.size());
 		for (int v = 0; v < vertexCount; ++v) {
 			const bool onFace = std::find(face.begin(), face.end(), v) != face.end();
-			const auto side = CGAL::orientation(a, b, c, toPoint3(points[v]));
+			const double distance = unitNormal.dot(points[v] - mean);
 			// Planar face, and the whole body behind it (outward orientation).
-			EXPECT_EQ(side, onFace ? CGAL::COPLANAR : CGAL::NEGATIVE) << "face " << f << ", vertex " << v;
+			if (onFace) {
+				EXPECT_LE(std::abs(distance), tolerance) << "face " << f << " is not planar at vertex " << v;
+			} else {
+				EXPECT_LT(distance, -tolerance) << "face " << f << ", vertex " << v << " is not behind it";
+			}
 		}
-		Vector3 faceCenter = Vector3::Zero();
+	Vector3 faceCenter = Vector3::Zero();
 		for (int v : face) faceCenter += points[v];
 		faceCenter /= static_cast<double>(face.size());
 		EXPECT_GT(normal.dot(faceCenter - inner), 0) << "face " << f << " normal points inward";
 
 		for (std::size_t k = 0; k < face.size(); ++k) {
-			const Vector3& p = points[face[k]];
-			const Vector3& q = points[face[(k + 1) % face.size()]];
+			const int from = face[k];
+			const int to = face[(k + 1) % face.size()];
+			const Vector3& p = points[from];
+			const Vector3& q = points[to];
 			const Vector3& r = points[face[(k + 2) % face.size()]];
-			EXPECT_GT((q - p).cross(r - q).dot(normal), 0) << "face " << f << " is not strictly convex at " << face[(k + 1) % face.size()];
-			const bool fresh = faceOfDirectedEdge.emplace(std::make_pair(face[k], face[(k + 1) % face.size()]), static_cast<int>(f)).second;
-			EXPECT_TRUE(fresh) << "directed edge " << face[k] << "->" << face[(k + 1) % face.size()] << " in two faces";
+			EXPECT_GT((q - p).cross(r - q).dot(normal), 0) << "face " << f << " is not strictly convex at " << to;
+			const bool fresh = faceOfDirectedEdge.emplace(std::make_pair(from, to), static_cast<int>(f)).second;
+			EXPECT_TRUE(fresh) << "directed edge " << from << "->" << to << " in two faces";
 		}
 	}
 	for (int v = 0; v < vertexCount; ++v) EXPECT_GE(facesAtVertex[v], 3) << "vertex " << v;
@@ -263,6 +335,34 @@ void expectValidPolyhedron(const ConvexPolyhedron& poly, const std::vector<Vecto
 		EXPECT_EQ(poly.edgeFaces[e][1], backward->second) << "edge " << e;
 	}
 	EXPECT_EQ(vertexCount - static_cast<int>(poly.edges.size()) + static_cast<int>(poly.faces.size()), 2) << "Euler";
+}
+
+// For input whose faces are exactly planar (axis-aligned, exactly permuted or
+// simplicial): each face is exactly coplanar and the body strictly behind it.
+void expectExactlyPlanarFaces(const ConvexPolyhedron& poly) {
+	for (std::size_t f = 0; f < poly.faces.size(); ++f) {
+		const std::vector<int>& face = poly.faces[f];
+		const Point3 a = toPoint3(poly.vertices[face[0]]), b = toPoint3(poly.vertices[face[1]]),
+		             c = toPoint3(poly.vertices[face[2]]);
+		for (int v = 0; v < static_cast<int>(poly.vertices.size()); ++v) {
+			const bool onFace = std::find(face.begin(), face.end(), v) != face.end();
+			const auto side = CGAL::orientation(a, b, c, toPoint3(poly.vertices[v]));
+			EXPECT_EQ(side, onFace ? CGAL::COPLANAR : CGAL::NEGATIVE) << "face " << f << ", vertex " << v;
+		}
+	}
+}
+
+// Faces whose corners are not exactly coplanar: merged within the tolerance.
+int inexactFaceCount(const ConvexPolyhedron& poly) {
+	int count = 0;
+	for (const auto& face : poly.faces) {
+		const Point3 a = toPoint3(poly.vertices[face[0]]), b = toPoint3(poly.vertices[face[1]]),
+		             c = toPoint3(poly.vertices[face[2]]);
+		bool exact = true;
+		for (std::size_t k = 3; k < face.size(); ++k) exact = exact && CGAL::coplanar(a, b, c, toPoint3(poly.vertices[face[k]]));
+		count += !exact;
+	}
+	return count;
 }
 
 std::multiset<std::size_t> faceSizes(const ConvexPolyhedron& poly) {
@@ -302,6 +402,7 @@ TEST(GeometryTopology, CubeHasSixQuadFacesAndTwelveEdges) {
 	const auto points = unitCube();
 	const auto poly = dda::buildConvexPolyhedron(points);
 	expectValidPolyhedron(poly, points);
+	expectExactlyPlanarFaces(poly);
 	EXPECT_EQ(poly.faces.size(), 6u);
 	EXPECT_EQ(faceSizes(poly), repeatedSize(6, 4));
 	EXPECT_EQ(poly.edges.size(), 12u);
@@ -321,6 +422,7 @@ TEST(GeometryTopology, OctahedronHasEightTrianglesAndTwelveEdges) {
 	const auto points = regularOctahedron();
 	const auto poly = dda::buildConvexPolyhedron(points);
 	expectValidPolyhedron(poly, points);
+	expectExactlyPlanarFaces(poly);
 	EXPECT_EQ(faceSizes(poly), repeatedSize(8, 3));
 	EXPECT_EQ(poly.edges.size(), 12u);
 }
@@ -329,6 +431,7 @@ TEST(GeometryTopology, HexagonalPrismHasTwoHexagonsAndSixQuads) {
 	const auto points = hexagonalPrism(0.7, 2.5);
 	const auto poly = dda::buildConvexPolyhedron(points);
 	expectValidPolyhedron(poly, points);
+	expectExactlyPlanarFaces(poly);
 	EXPECT_EQ(faceSizes(poly), (std::multiset<std::size_t>{4, 4, 4, 4, 4, 4, 6, 6}));
 	EXPECT_EQ(poly.edges.size(), 18u);
 }
@@ -349,6 +452,7 @@ TEST(GeometryTopology, AxisAlignedBoxesOfAnyShapeAndScaleHaveSixQuads) {
 		const auto points = boxCorners(c.lo, c.size);
 		const auto poly = dda::buildConvexPolyhedron(points);
 		expectValidPolyhedron(poly, points);
+		expectExactlyPlanarFaces(poly);
 		EXPECT_EQ(faceSizes(poly), repeatedSize(6, 4));
 		EXPECT_EQ(poly.edges.size(), 12u);
 	}
@@ -361,24 +465,160 @@ TEST(GeometryTopology, QuarterTurnRotatedBoxStillHasSixQuads) {
 	const auto points = moved(boxCorners({0.1, 0.2, 0.3}, {0.1 + 0.2, 0.7, 1.3}), quarterTurn, {0.1 + 0.2, -0.7, 5});
 	const auto poly = dda::buildConvexPolyhedron(points);
 	expectValidPolyhedron(poly, points);
+	expectExactlyPlanarFaces(poly);
 	EXPECT_EQ(faceSizes(poly), repeatedSize(6, 4));
 }
 
-TEST(GeometryTopology, GenericallyRotatedBoxIsAValidClosedSurface) {
+TEST(GeometryTopology, GenericallyRotatedBoxHasSixQuads) {
 	// After a generic rotation the 4 rounded corners of a side are usually not
-	// exactly coplanar any more; exact predicates then keep such a side as two
-	// triangles. Either way the result must be a valid polyhedron with the
-	// box's volume.
+	// exactly coplanar any more; they are within round-off, so still one face.
 	const Vector3 size(1, 2, 3);
 	const Matrix3 R = rotation(0.3, {1, 0.1 + 0.2, 0.7});
-	const auto points = moved(boxCorners(-size / 2, size), R, {0.1, 0.2, 0.3});
+	const auto points = rotatedBox(size, R, {0.1, 0.2, 0.3});
 	const auto poly = dda::buildConvexPolyhedron(points);
 	expectValidPolyhedron(poly, points);
-	EXPECT_GE(poly.faces.size(), 6u);
-	EXPECT_LE(poly.faces.size(), 12u);
+	EXPECT_EQ(faceSizes(poly), repeatedSize(6, 4));
+	EXPECT_EQ(poly.edges.size(), 12u);
+	EXPECT_GT(inexactFaceCount(poly), 0) << "the rotation no longer exercises the tolerance";
 	const MassProperties mass = dda::computeMassProperties(poly.vertices, poly.faces);
 	EXPECT_LE(relativeError(mass.volume, size.prod()), kRelTol);
 	EXPECT_LE(relativeError(mass.secondMoment, R * boxSecondMoment(size) * R.transpose()), kRelTol);
+}
+
+TEST(GeometryTopology, RandomlyPlacedBoxesOfAllScalesHaveSixQuads) {
+	// 200 boxes: uniformly random rotations, sides from 1e-3 m to 1e3 m (log
+	// uniform, aspect up to 3:1), centres anywhere within 1e3 m of the origin.
+	int inexactFaces = 0;
+	for (unsigned seed = 0; seed < 200; ++seed) {
+		Uniform uniform(seed);
+		const Matrix3 R = randomRotation(uniform);
+		const double scale = std::pow(10.0, uniform.in(-3, 3));
+		const Vector3 size = scale * uniform.in(Vector3::Constant(0.5), Vector3::Constant(1.5));
+		const Vector3 center = uniform.in(Vector3::Constant(-1e3), Vector3::Constant(1e3));
+		SCOPED_TRACE(testing::Message() << "seed " << seed << ", size " << size.transpose() << ", centre "
+		                                << center.transpose());
+		const auto points = rotatedBox(size, R, center);
+		const auto poly = dda::buildConvexPolyhedron(points);
+		expectValidPolyhedron(poly, points);
+		EXPECT_EQ(faceSizes(poly), repeatedSize(6, 4));
+		EXPECT_EQ(poly.edges.size(), 12u);
+		inexactFaces += inexactFaceCount(poly);
+	}
+	// Most sides are merged by the tolerance, not by exact coplanarity.
+	EXPECT_GT(inexactFaces, 600) << inexactFaces << " of 1200 sides were not exactly planar";
+}
+
+TEST(GeometryTopology, RandomlyPlacedSlenderBoxesHaveSixQuads) {
+	// A 60:1 column: long thin faces, the worst conditioned planes of a box.
+	for (unsigned seed = 0; seed < 100; ++seed) {
+		Uniform uniform(1000 + seed);
+		const Matrix3 R = randomRotation(uniform);
+		const Vector3 size = std::pow(10.0, uniform.in(-2, 1)) * Vector3(60, 1, 1);
+		const Vector3 center = uniform.in(Vector3::Constant(-1e3), Vector3::Constant(1e3));
+		SCOPED_TRACE(testing::Message() << "seed " << seed << ", size " << size.transpose());
+		const auto points = rotatedBox(size, R, center);
+		const auto poly = dda::buildConvexPolyhedron(points);
+		expectValidPolyhedron(poly, points);
+		EXPECT_EQ(faceSizes(poly), repeatedSize(6, 4));
+		EXPECT_EQ(poly.edges.size(), 12u);
+	}
+}
+
+TEST(GeometryTopology, RandomlyPlacedHexagonalPrismsHaveEightFaces) {
+	for (unsigned seed = 0; seed < 100; ++seed) {
+		Uniform uniform(2000 + seed);
+		const Matrix3 R = randomRotation(uniform);
+		const double scale = std::pow(10.0, uniform.in(-2, 2));
+		const Vector3 center = uniform.in(Vector3::Constant(-1e3), Vector3::Constant(1e3));
+		SCOPED_TRACE(testing::Message() << "seed " << seed);
+		const auto points = moved(hexagonalPrism(0.7 * scale, 2.5 * scale), R, center);
+		const auto poly = dda::buildConvexPolyhedron(points);
+		expectValidPolyhedron(poly, points);
+		EXPECT_EQ(faceSizes(poly), (std::multiset<std::size_t>{4, 4, 4, 4, 4, 4, 6, 6}));
+		EXPECT_EQ(poly.edges.size(), 18u);
+	}
+}
+
+TEST(GeometryTopology, RandomlyPlacedOctahedraHaveEightTriangles) {
+	for (unsigned seed = 0; seed < 100; ++seed) {
+		Uniform uniform(3000 + seed);
+		const Matrix3 R = randomRotation(uniform);
+		const double scale = std::pow(10.0, uniform.in(-2, 2));
+		const Vector3 center = uniform.in(Vector3::Constant(-1e3), Vector3::Constant(1e3));
+		SCOPED_TRACE(testing::Message() << "seed " << seed);
+		std::vector<Vector3> octahedron = regularOctahedron();
+		for (Vector3& p : octahedron) p *= scale;
+		const auto points = moved(octahedron, R, center);
+		const auto poly = dda::buildConvexPolyhedron(points);
+		expectValidPolyhedron(poly, points);
+		EXPECT_EQ(faceSizes(poly), repeatedSize(8, 3));
+		EXPECT_EQ(poly.edges.size(), 12u);
+	}
+}
+
+TEST(GeometryTopology, FinelyTessellatedSphereDoesNotMergeIntoCurvedFaces) {
+	// Neighbouring hull triangles of a 200-point sphere are tilted against each
+	// other: a merge that compared each triangle with the last one added (and
+	// not with one fixed plane) could chain them into one curved "face".
+	for (const Vector3& center : {Vector3(0, 0, 0), Vector3(3, -2, 1), Vector3(-700, 400, 900)}) {
+		SCOPED_TRACE(testing::Message() << "centre " << center.transpose());
+		const auto points = fibonacciSphere(200, 2.0, center);
+		const auto poly = dda::buildConvexPolyhedron(points);
+		expectValidPolyhedron(poly, points);  // includes: every face planar within the tolerance
+		std::size_t largest = 0;
+		for (const auto& face : poly.faces) largest = std::max(largest, face.size());
+		EXPECT_LE(largest, 6u);
+		EXPECT_GE(poly.faces.size(), 2 * points.size() - 4 - 20);  // nearly simplicial
+	}
+}
+
+TEST(GeometryTopology, FaceNormalIsTheUnitOutwardNewellNormal) {
+	const auto cube = dda::buildConvexPolyhedron(unitCube());
+	for (const auto& face : cube.faces) {
+		const Vector3 n = dda::faceNormal(cube.vertices, face);
+		// Axis-aligned, pointing away from the cube's centre.
+		Vector3 mean = Vector3::Zero();
+		for (int v : face) mean += cube.vertices[v];
+		mean /= static_cast<double>(face.size());
+		const Vector3 expected = (2 * mean - Vector3::Ones());
+		EXPECT_LE((n - expected).norm(), 1e-15) << n.transpose();
+	}
+
+	// A rotated box far from the origin: the normals are the rotated axes.
+	Uniform uniform(7);
+	const Matrix3 R = randomRotation(uniform);
+	const Vector3 center(1e3, -1e3, 500);
+	const auto points = rotatedBox({1e-2, 2e-2, 3e-2}, R, center);
+	const auto poly = dda::buildConvexPolyhedron(points);
+	ASSERT_EQ(poly.faces.size(), 6u);
+	for (const auto& face : poly.faces) {
+		const Vector3 n = dda::faceNormal(poly.vertices, face);
+		EXPECT_NEAR(n.norm(), 1, 1e-15);
+		const Vector3 local = R.transpose() * n;  // one of +-e_x, +-e_y, +-e_z
+		Eigen::Index axis;
+		local.cwiseAbs().maxCoeff(&axis);
+		EXPECT_LE((local - Vector3::Unit(axis) * (local[axis] > 0 ? 1 : -1)).norm(), 1e-9) << local.transpose();
+		Vector3 mean = Vector3::Zero();
+		for (int v : face) mean += poly.vertices[v];
+		EXPECT_GT(n.dot(mean / 4 - center), 0) << "normal points inward";
+	}
+
+	EXPECT_THROW(dda::faceNormal(cube.vertices, {0, 1}), dda::InputError);
+	EXPECT_THROW(dda::faceNormal(cube.vertices, {0, 1, 8}), dda::InputError);
+	EXPECT_THROW(dda::faceNormal(cube.vertices, {0, 1, -1}), dda::InputError);
+	const std::vector<Vector3> collinear{{0, 0, 0}, {1, 0, 0}, {2, 0, 0}};
+	EXPECT_THROW(dda::faceNormal(collinear, {0, 1, 2}), dda::InputError);
+}
+
+TEST(GeometryTopology, CornerJustAboveTheToleranceIsAFaceOfItsOwn) {
+	// A cube with a pyramid of height 1e-6 on top: a real (if low) apex, far
+	// above 1e-9 x size, so the top is 4 triangles.
+	auto points = unitCube();
+	points.emplace_back(0.5, 0.5, 1 + 1e-6);
+	const auto poly = dda::buildConvexPolyhedron(points);
+	expectValidPolyhedron(poly, points);
+	EXPECT_EQ(faceSizes(poly), (std::multiset<std::size_t>{3, 3, 3, 3, 4, 4, 4, 4, 4}));
+	EXPECT_EQ(poly.edges.size(), 16u);
 }
 
 TEST(GeometryTopology, InputOrderIsPreserved) {
@@ -389,6 +629,7 @@ TEST(GeometryTopology, InputOrderIsPreserved) {
 	std::rotate(points.begin(), points.begin() + 3, points.end());
 	const auto poly = dda::buildConvexPolyhedron(points);
 	expectValidPolyhedron(poly, points);
+	expectExactlyPlanarFaces(poly);
 	EXPECT_EQ(faceSizes(poly), repeatedSize(6, 4));
 }
 
@@ -398,6 +639,7 @@ TEST(GeometryTopology, PointsOnAnEllipsoidGiveASimplicialPolyhedron) {
 	const auto points = ellipsoidPoints(16, {1.5, 1.0, 0.7}, {2, -1, 0.5});
 	const auto poly = dda::buildConvexPolyhedron(points);
 	expectValidPolyhedron(poly, points);
+	expectExactlyPlanarFaces(poly);
 	const std::size_t v = points.size();
 	EXPECT_EQ(poly.faces.size(), 2 * v - 4);
 	EXPECT_EQ(poly.edges.size(), 3 * v - 6);
@@ -413,6 +655,7 @@ TEST(GeometryMass, UnitTetrahedronMatchesHandIntegration) {
 	const std::vector<Vector3> points{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
 	const auto poly = dda::buildConvexPolyhedron(points);
 	expectValidPolyhedron(poly, points);
+	expectExactlyPlanarFaces(poly);
 	EXPECT_EQ(poly.faces.size(), 4u);
 	EXPECT_EQ(poly.edges.size(), 6u);
 
@@ -428,6 +671,7 @@ TEST(GeometryMass, GeneralTetrahedronMatchesClosedForm) {
 	const std::vector<Vector3> points{{0.3, -1.2, 2.0}, {2.1, 0.4, 1.7}, {-0.5, 1.9, 2.6}, {0.8, 0.2, 4.4}};
 	const auto poly = dda::buildConvexPolyhedron(points);
 	expectValidPolyhedron(poly, points);
+	expectExactlyPlanarFaces(poly);
 	const MassProperties mass = dda::computeMassProperties(poly.vertices, poly.faces);
 
 	const Moments expected = tetrahedronMoments(points[0], points[1], points[2], points[3]);
@@ -555,6 +799,31 @@ TEST(GeometryMass, BoxFarFromOriginKeepsItsMoments) {
 	EXPECT_LE(relativeError(mass.secondMoment.trace(), expectedJ.trace()), kRelTol);
 }
 
+TEST(GeometryMass, RandomlyPlacedBoxesMatchClosedForm) {
+	// The boxes of RandomlyPlacedBoxesOfAllScalesHaveSixQuads, now merged into
+	// nearly planar quads: the fan triangles still close the surface, so V, c
+	// and J are exact up to round-off. Rounding the corners themselves changes
+	// the box by ~1e-16 x (distance from origin / size) relative, so centres
+	// stay within 1e3 x size of the origin (and within 1e3 m) to leave 1e-12
+	// meaningful.
+	for (unsigned seed = 0; seed < 200; ++seed) {
+		Uniform uniform(seed);
+		const Matrix3 R = randomRotation(uniform);
+		const double scale = std::pow(10.0, uniform.in(-3, 3));
+		const Vector3 size = scale * uniform.in(Vector3::Constant(0.5), Vector3::Constant(1.5));
+		const double reach = std::min(1e3, 1e3 * scale);
+		const Vector3 center = uniform.in(Vector3::Constant(-reach), Vector3::Constant(reach));
+		SCOPED_TRACE(testing::Message() << "seed " << seed << ", size " << size.transpose() << ", centre "
+		                                << center.transpose());
+		const auto poly = dda::buildConvexPolyhedron(rotatedBox(size, R, center));
+		ASSERT_EQ(faceSizes(poly), repeatedSize(6, 4));
+		const MassProperties mass = dda::computeMassProperties(poly.vertices, poly.faces);
+		EXPECT_LE(relativeError(mass.volume, size.prod()), kRelTol);
+		EXPECT_LE((mass.centroid - center).norm(), kRelTol * size.norm());
+		EXPECT_LE(relativeError(mass.secondMoment, R * boxSecondMoment(size) * R.transpose()), kRelTol);
+	}
+}
+
 TEST(GeometryMass, RejectsFacesThatDoNotEncloseVolume) {
 	const auto poly = dda::buildConvexPolyhedron(unitCube());
 	std::vector<std::vector<int>> inward = poly.faces;
@@ -639,4 +908,51 @@ TEST(GeometryInput, RejectsPointsOnTheSurfaceThatAreNotCorners) {
 	points = regularOctahedron();
 	points.insert(points.begin(), Vector3(0.5, 0.5, 0));
 	expectInputError(points, {"point 0 ", "not a corner"});
+}
+
+TEST(GeometryInput, RejectsNonCornersOfRotatedBoxes) {
+	// A face centre, an edge midpoint and an inner point of a randomly placed
+	// box, after rounding: slightly off the (nearly planar) faces either way.
+	for (unsigned seed = 0; seed < 50; ++seed) {
+		Uniform uniform(4000 + seed);
+		const Matrix3 R = randomRotation(uniform);
+		const Vector3 size = std::pow(10.0, uniform.in(-2, 2)) * uniform.in(Vector3::Constant(0.5), Vector3::Constant(1.5));
+		const Vector3 center = uniform.in(Vector3::Constant(-1e3), Vector3::Constant(1e3));
+		SCOPED_TRACE(testing::Message() << "seed " << seed);
+		const auto box = rotatedBox(size, R, center);
+		const auto at = [&](const Vector3& local) { return Vector3(R * local.cwiseProduct(size) + center); };
+
+		auto points = box;
+		points.push_back(at({0.5, 0, 0}));  // centre of the +x face
+		expectInputError(points, {"point 8 ", "on the hull surface but is not a corner", "inside a face"});
+
+		points = box;
+		points.insert(points.begin() + 2, at({0.5, 0.5, 0}));  // midpoint of an edge
+		expectInputError(points, {"point 2 ", "on the hull surface but is not a corner", "inside an edge"});
+
+		points = box;
+		points.push_back(at({0.1, -0.2, 0.3}));
+		expectInputError(points, {"point 8 ", "strictly inside"});
+	}
+}
+
+TEST(GeometryInput, RejectsACornerWithinTheToleranceOfAFacePlane) {
+	// A pyramid of height 1e-12 on a unit cube: a true corner, but as close to
+	// the top plane as round-off could put a point of that face. Rejected,
+	// never silently dropped.
+	auto points = unitCube();
+	points.emplace_back(0.5, 0.5, 1 + 1e-12);
+	expectInputError(points, {"point 8 ", "within 1e-09 x the bounding-box diagonal of the plane of the face with corners",
+	                          "the block is too flat there"});
+
+	// The same, rotated and moved: still rejected.
+	Uniform uniform(5);
+	const Matrix3 R = randomRotation(uniform);
+	expectInputError(moved(points, R, {10, 20, -30}), {"point 8 ", "too flat there"});
+}
+
+TEST(GeometryInput, RejectsBlocksThinnerThanTheTolerance) {
+	// Not coplanar (exactly), but flatter than 1e-9 x size everywhere.
+	expectInputError(boxCorners({0, 0, 0}, {1, 1, 1e-10}), {"within 1e-09 x", "too flat"});
+	expectInputError({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0.3, 0.3, 1e-11}}, {"within 1e-09 x", "too flat"});
 }

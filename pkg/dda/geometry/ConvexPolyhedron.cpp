@@ -3,17 +3,22 @@
 // Pipeline (one function per step):
 //   1. validate the raw points (count, finiteness, distinctness, volume);
 //   2. hull the points with CGAL (triangles, outward);
-//   3. merge adjacent hull triangles that are exactly coplanar into facets;
-//   4. check that every input point is a corner of the hull;
-//   5. trace each facet's boundary as one counter-clockwise vertex cycle;
+//   3. grow facets: from the largest unassigned hull triangle, whose plane
+//      becomes the facet's plane, add neighbouring triangles whose corners lie
+//      on that plane (exactly coplanar, or within the scaled tolerance);
+//   4. trace each facet's boundary as one counter-clockwise vertex cycle;
+//   5. check that every input point is a corner of the merged faces, and that
+//      every face is a strictly convex polygon;
 //   6. list the edges with the two faces that share each, and check Euler.
-// Every side-of decision (collinear, coplanar, inside) uses CGAL's exact
-// predicates, so the topology is a function of the input doubles alone.
+// Collinear, coplanar and inside decisions on the raw points use CGAL's exact
+// predicates; only the face merge adds a tolerance (kCoplanarRelativeTolerance,
+// see the header), so the topology of a rotated box is that of a box.
 #include "ConvexPolyhedron.hpp"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/convex_hull_3.h>
+#include <Eigen/Geometry>
 
 #include <algorithm>
 #include <charconv>
@@ -182,136 +187,290 @@ std::vector<Triangle> hullTriangles(const std::vector<Vector3>& points) {
 
 // ---------------------------------------------------------------- step 3
 
-// Facets: groups of hull triangles in one plane, each with one triangle that
-// spans that plane (hull triangles are never degenerate, checked below).
+// A facet's plane: unit outward normal through a point of the plane.
+struct Plane {
+	Vector3 normal;
+	Vector3 point;
+	double signedDistance(const Vector3& p) const { return normal.dot(p - point); }
+};
+
+// The plane of a hull triangle and twice its area. The cross product is taken
+// at the corner opposite the longest edge (the two shortest edges), which
+// keeps its round-off smallest; a cyclic shift keeps the orientation.
+struct TrianglePlane {
+	Plane plane;
+	double doubleArea;
+};
+
+TrianglePlane trianglePlane(const std::vector<Vector3>& points, const Triangle& tri) {
+	int corner = 0;
+	double longest = -1;
+	for (int k = 0; k < 3; ++k) {
+		const double opposite = (points[tri[(k + 1) % 3]] - points[tri[(k + 2) % 3]]).squaredNorm();
+		if (opposite > longest) {
+			longest = opposite;
+			corner = k;
+		}
+	}
+	const Vector3& o = points[tri[corner]];
+	const Vector3 n = (points[tri[(corner + 1) % 3]] - o).cross(points[tri[(corner + 2) % 3]] - o);
+	const double doubleArea = n.norm();
+	if (!(doubleArea > 0)) internalError("hull triangle with zero area");
+	return {{n / doubleArea, (points[tri[0]] + points[tri[1]] + points[tri[2]]) / 3.0}, doubleArea};
+}
+
+// Facets: groups of hull triangles in one face plane. Each facet's plane is
+// that of its seed, the largest of its triangles, fixed before the facet grows.
 struct Facets {
 	std::vector<int> facetOfTriangle;           // triangle index -> facet index
-	std::vector<Triangle> planeOf;              // facet index -> triangle in its plane
+	std::vector<Triangle> seedOf;               // facet index -> its largest triangle
+	std::vector<Plane> planeOf;                 // facet index -> plane of the seed
+	std::vector<bool> exactOf;                  // facet index -> all triangles exactly coplanar
 	std::vector<std::vector<int>> trianglesOf;  // facet index -> its triangles
 };
 
-int findRoot(std::vector<int>& parent, int i) {
-	while (parent[i] != i) {
-		parent[i] = parent[parent[i]];
-		i = parent[i];
+enum class OnPlane { no, exactly, withinTolerance };
+
+// Whether point p lies on the plane of facet f: exactly coplanar with its seed
+// (decided exactly, so exact input never depends on the tolerance), or within
+// `tolerance` of the seed's plane.
+OnPlane onFacetPlane(const std::vector<Vector3>& points, const Facets& facets, int f, const Vector3& p,
+                     double tolerance) {
+	const Triangle& seed = facets.seedOf[f];
+	if (CGAL::coplanar(toPoint3(points[seed[0]]), toPoint3(points[seed[1]]), toPoint3(points[seed[2]]), toPoint3(p))) {
+		return OnPlane::exactly;
 	}
-	return i;
+	return std::abs(facets.planeOf[f].signedDistance(p)) <= tolerance ? OnPlane::withinTolerance : OnPlane::no;
 }
 
-Facets mergeCoplanarTriangles(const std::vector<Vector3>& points, const std::vector<Triangle>& triangles) {
+// Region growing. Seeds are taken largest first (the best-conditioned plane);
+// a neighbour across the facet's boundary joins when its corner off the shared
+// edge lies on the seed's plane. Its other two corners are corners of the
+// facet already, so every corner of every triangle of a facet lies on the
+// facet's plane: the test is against one fixed plane, never against the last
+// triangle added, so slightly tilted triangles cannot chain into a curved face.
+Facets growFacets(const std::vector<Vector3>& points, const std::vector<Triangle>& triangles, double tolerance) {
 	const auto at = [&](int i) { return toPoint3(points[i]); };
+	const int triangleCount = static_cast<int>(triangles.size());
 
 	std::map<DirectedEdge, int> triangleOfEdge;
-	for (std::size_t t = 0; t < triangles.size(); ++t) {
+	for (int t = 0; t < triangleCount; ++t) {
 		const Triangle& tri = triangles[t];
 		if (CGAL::collinear(at(tri[0]), at(tri[1]), at(tri[2]))) internalError("degenerate hull triangle");
 		for (int k = 0; k < 3; ++k) {
-			if (!triangleOfEdge.emplace(DirectedEdge{tri[k], tri[(k + 1) % 3]}, static_cast<int>(t)).second) {
+			if (!triangleOfEdge.emplace(DirectedEdge{tri[k], tri[(k + 1) % 3]}, t).second) {
 				internalError("hull edge used twice in one direction");
 			}
 		}
 	}
-
-	std::vector<int> parent(triangles.size());
-	std::iota(parent.begin(), parent.end(), 0);
-	for (std::size_t t = 0; t < triangles.size(); ++t) {
-		const Triangle& tri = triangles[t];
+	// across[t][k]: the triangle on the other side of edge tri[k] -> tri[k+1].
+	std::vector<std::array<int, 3>> across(triangles.size());
+	for (int t = 0; t < triangleCount; ++t) {
 		for (int k = 0; k < 3; ++k) {
-			const auto across = triangleOfEdge.find({tri[(k + 1) % 3], tri[k]});
-			if (across == triangleOfEdge.end()) internalError("hull is not closed");
-			const Triangle& other = triangles[across->second];
-			// The neighbour's vertex that is not on the shared edge.
-			int apex = other[0];
-			for (int v : other) {
-				if (v != tri[k] && v != tri[(k + 1) % 3]) apex = v;
-			}
-			if (CGAL::coplanar(at(tri[0]), at(tri[1]), at(tri[2]), at(apex))) {
-				parent[findRoot(parent, static_cast<int>(t))] = findRoot(parent, across->second);
-			}
+			const auto found = triangleOfEdge.find({triangles[t][(k + 1) % 3], triangles[t][k]});
+			if (found == triangleOfEdge.end()) internalError("hull is not closed");
+			across[t][k] = found->second;
 		}
 	}
 
+	// Largest first; ties by sorted corner indices, so the result does not
+	// depend on the order in which the hull algorithm lists its triangles.
+	std::vector<double> doubleArea(triangles.size());
+	std::vector<Triangle> sortedCorners(triangles);
+	for (int t = 0; t < triangleCount; ++t) {
+		doubleArea[t] = trianglePlane(points, triangles[t]).doubleArea;
+		std::sort(sortedCorners[t].begin(), sortedCorners[t].end());
+	}
+	std::vector<int> seedOrder(triangles.size());
+	std::iota(seedOrder.begin(), seedOrder.end(), 0);
+	std::sort(seedOrder.begin(), seedOrder.end(), [&](int a, int b) {
+		if (doubleArea[a] != doubleArea[b]) return doubleArea[a] > doubleArea[b];
+		return sortedCorners[a] < sortedCorners[b];
+	});
+
 	Facets facets;
 	facets.facetOfTriangle.assign(triangles.size(), -1);
-	std::map<int, int> facetOfRoot;
-	for (std::size_t t = 0; t < triangles.size(); ++t) {
-		const int root = findRoot(parent, static_cast<int>(t));
-		const auto inserted = facetOfRoot.emplace(root, static_cast<int>(facets.planeOf.size()));
-		if (inserted.second) {
-			facets.planeOf.push_back(triangles[t]);
-			facets.trianglesOf.emplace_back();
+	for (int seed : seedOrder) {
+		if (facets.facetOfTriangle[seed] >= 0) continue;
+		const int f = static_cast<int>(facets.seedOf.size());
+		facets.seedOf.push_back(triangles[seed]);
+		facets.planeOf.push_back(trianglePlane(points, triangles[seed]).plane);
+		facets.exactOf.push_back(true);
+		facets.trianglesOf.push_back({seed});
+		facets.facetOfTriangle[seed] = f;
+
+		for (std::size_t next = 0; next < facets.trianglesOf[f].size(); ++next) {
+			const int t = facets.trianglesOf[f][next];
+			for (int k = 0; k < 3; ++k) {
+				const int u = across[t][k];
+				if (facets.facetOfTriangle[u] >= 0) continue;
+				// The neighbour's corner that is not on the shared edge.
+				int apex = -1;
+				for (int v : triangles[u]) {
+					if (v != triangles[t][k] && v != triangles[t][(k + 1) % 3]) apex = v;
+				}
+				const OnPlane on = onFacetPlane(points, facets, f, points[apex], tolerance);
+				if (on == OnPlane::no) continue;
+				if (on == OnPlane::withinTolerance) facets.exactOf[f] = false;
+				facets.facetOfTriangle[u] = f;
+				facets.trianglesOf[f].push_back(u);
+			}
 		}
-		facets.facetOfTriangle[t] = inserted.first->second;
-		facets.trianglesOf[inserted.first->second].push_back(static_cast<int>(t));
 	}
 	return facets;
 }
 
 // ---------------------------------------------------------------- step 4
 
-// Every input point must be a corner of the hull. Decided exactly by counting
-// the facet planes through each point; reports the first offender in input
-// order.
-void requireAllCorners(const std::vector<Vector3>& points, const Facets& facets) {
-	for (std::size_t i = 0; i < points.size(); ++i) {
-		const Point3 p = toPoint3(points[i]);
-		int planesThrough = 0;
-		for (const Triangle& plane : facets.planeOf) {
-			const auto side = CGAL::orientation(toPoint3(points[plane[0]]), toPoint3(points[plane[1]]),
-			                                    toPoint3(points[plane[2]]), p);
-			if (side == CGAL::POSITIVE) internalError("input point outside its own hull");
-			if (side == CGAL::COPLANAR) ++planesThrough;
-		}
-		if (planesThrough >= kMinFacetsAtCorner) continue;
-
-		const std::string prefix = "point " + std::to_string(i) + " " + formatPoint(points[i]);
-		if (planesThrough == 0) {
-			throw InputError(prefix + " lies strictly inside the hull of the others: the input is not convex");
-		}
-		const std::string where = planesThrough == 1 ? "inside a face" : "inside an edge";
-		throw InputError(prefix + " lies on the hull surface but is not a corner (it is " + where + ")");
-	}
+std::string formatIndexList(const std::vector<int>& indices) {
+	std::string text;
+	for (std::size_t k = 0; k < indices.size(); ++k) text += (k ? ", " : "") + std::to_string(indices[k]);
+	return text;
 }
 
-// ---------------------------------------------------------------- step 5
+std::string toleranceText() {
+	return formatNumber(kCoplanarRelativeTolerance) + " x the bounding-box diagonal";
+}
 
 // The facet's boundary: its triangles' directed edges whose reverse belongs to
 // another facet, chained head to tail. Triangles are counter-clockwise from
-// outside, so the chain is too.
+// outside, so the chain is too. Starts at the smallest index (canonical).
+// A boundary that is not one simple cycle can only come from a tolerance
+// merge of a nearly flat block; an exactly planar facet always has one.
 std::vector<int> traceFacetBoundary(const std::vector<Triangle>& triangles, const Facets& facets, int facet) {
+	const Triangle& seed = facets.seedOf[facet];
+	const auto fail = [&](const std::string& what) {
+		if (facets.exactOf[facet]) internalError("facet boundary " + what);
+		if (facets.trianglesOf[facet].size() == triangles.size()) {
+			throw InputError("all points lie within " + toleranceText() + " of one plane: the block is too flat");
+		}
+		throw InputError("the hull triangles within " + toleranceText() + " of the plane through points " +
+		                 formatIndexList({seed[0], seed[1], seed[2]}) +
+		                 " do not form one simple polygon (" + what + "): the block is too flat there");
+	};
+
 	std::set<DirectedEdge> inside;
 	for (int t : facets.trianglesOf[facet]) {
 		for (int k = 0; k < 3; ++k) inside.insert({triangles[t][k], triangles[t][(k + 1) % 3]});
 	}
 	std::map<int, int> nextOf;
+	std::set<int> heads;
 	for (const DirectedEdge& e : inside) {
 		if (inside.count({e.second, e.first})) continue;  // interior diagonal
-		if (!nextOf.emplace(e.first, e.second).second) internalError("facet boundary is not a simple cycle");
+		if (!nextOf.emplace(e.first, e.second).second || !heads.insert(e.second).second) {
+			fail("is not a simple cycle");
+		}
 	}
-	if (nextOf.empty()) internalError("facet without boundary");
+	if (nextOf.empty()) fail("is empty");
 
 	std::vector<int> cycle;
-	int v = nextOf.begin()->first;  // the smallest index: a canonical start
+	int v = nextOf.begin()->first;
 	do {
 		cycle.push_back(v);
 		const auto next = nextOf.find(v);
-		if (next == nextOf.end() || cycle.size() > nextOf.size()) internalError("facet boundary is open");
+		if (next == nextOf.end() || cycle.size() > nextOf.size()) fail("is open");
 		v = next->second;
 	} while (v != cycle.front());
-	if (cycle.size() != nextOf.size()) internalError("facet boundary has several cycles");
+	if (cycle.size() != nextOf.size()) fail("has several cycles");
 	return cycle;
 }
 
-std::vector<std::vector<int>> faceCycles(const std::vector<Triangle>& triangles, const Facets& facets) {
-	std::vector<std::vector<int>> faces;
-	faces.reserve(facets.planeOf.size());
-	for (std::size_t f = 0; f < facets.planeOf.size(); ++f) {
-		faces.push_back(traceFacetBoundary(triangles, facets, static_cast<int>(f)));
+std::vector<std::vector<int>> facetBoundaries(const std::vector<Triangle>& triangles, const Facets& facets) {
+	std::vector<std::vector<int>> cycles;
+	cycles.reserve(facets.seedOf.size());
+	for (std::size_t f = 0; f < facets.seedOf.size(); ++f) {
+		cycles.push_back(traceFacetBoundary(triangles, facets, static_cast<int>(f)));
 	}
-	// Each cycle starts at its smallest index; sorting makes the face order
-	// independent of the hull algorithm's internal order.
-	std::sort(faces.begin(), faces.end());
-	return faces;
+	return cycles;
+}
+
+// ---------------------------------------------------------------- step 5
+
+// Every input point must be a corner of the merged faces: on the boundary of at
+// least 3 of them. Otherwise the faces whose plane it lies on (exactly or
+// within the tolerance, the same test as the merge) tell where it is: none,
+// strictly inside; one, inside a face; two, inside an edge. A real corner
+// within the tolerance of a face plane is indistinguishable from round-off and
+// is rejected the same way; the message says so. Reports the first offender
+// in input order.
+void requireAllCorners(const std::vector<Vector3>& points, const Facets& facets,
+                       const std::vector<std::vector<int>>& cycles, double tolerance) {
+	std::vector<std::set<int>> cyclesAt(points.size());
+	for (std::size_t f = 0; f < cycles.size(); ++f) {
+		for (int v : cycles[f]) cyclesAt[v].insert(static_cast<int>(f));
+	}
+	const int facetCount = static_cast<int>(facets.seedOf.size());
+
+	for (std::size_t i = 0; i < points.size(); ++i) {
+		for (int f = 0; f < facetCount; ++f) {
+			if (facets.planeOf[f].signedDistance(points[i]) > tolerance) internalError("input point outside its own hull");
+		}
+		if (cyclesAt[i].size() >= static_cast<std::size_t>(kMinFacetsAtCorner)) continue;
+
+		std::vector<int> near;
+		for (int f = 0; f < facetCount; ++f) {
+			if (cyclesAt[i].count(f) || onFacetPlane(points, facets, f, points[i], tolerance) != OnPlane::no) {
+				near.push_back(f);
+			}
+		}
+
+		const std::string prefix = "point " + std::to_string(i) + " " + formatPoint(points[i]);
+		if (near.empty()) {
+			throw InputError(prefix + " lies strictly inside the hull of the others: the input is not convex");
+		}
+		std::string faces;
+		for (std::size_t k = 0; k < near.size(); ++k) {
+			if (k > 0) faces += k + 1 == near.size() ? " and " : "; ";
+			faces += formatIndexList(cycles[near[k]]);
+		}
+		std::string where;
+		if (near.size() == 1) {
+			where = "it is inside a face, within " + toleranceText() + " of the plane of the face with corners " + faces;
+		} else if (near.size() == 2) {
+			where = "it is inside an edge, within " + toleranceText() + " of the planes of the faces with corners " +
+			        faces;
+		} else {
+			// Within the tolerance of 3 or more planes: next to the corner they
+			// share, if there is one.
+			std::set<int> shared(cycles[near[0]].begin(), cycles[near[0]].end());
+			for (int f : near) {
+				std::set<int> kept;
+				for (int v : cycles[f]) {
+					if (shared.count(v)) kept.insert(v);
+				}
+				shared = kept;
+			}
+			where = "it is within " + toleranceText() + " of the planes of the faces with corners " + faces;
+			if (shared.size() == 1) where += ", next to their common corner " + std::to_string(*shared.begin());
+		}
+		throw InputError(prefix + " lies on the hull surface but is not a corner: " + where +
+		                 " (if it is meant as a corner, the block is too flat there)");
+	}
+}
+
+// Each face, seen from outside by its Newell normal, must turn left at every
+// corner. Exactly planar faces of a convex hull always do; a tolerance merge
+// of a nearly flat block may not.
+void requireConvexFaces(const std::vector<Vector3>& points, const Facets& facets,
+                        const std::vector<std::vector<int>>& cycles) {
+	for (std::size_t f = 0; f < cycles.size(); ++f) {
+		const std::vector<int>& cycle = cycles[f];
+		const std::string face = "the face with corners " + formatIndexList(cycle);
+		const Vector3 normal = faceNormal(points, cycle);
+		if (!(normal.dot(facets.planeOf[f].normal) > 0)) {
+			throw InputError(face + " faces inward after merging within " + toleranceText() +
+			                 ": the block is too flat there");
+		}
+		for (std::size_t k = 0; k < cycle.size(); ++k) {
+			const Vector3& p = points[cycle[k]];
+			const Vector3& q = points[cycle[(k + 1) % cycle.size()]];
+			const Vector3& r = points[cycle[(k + 2) % cycle.size()]];
+			if (!((q - p).cross(r - q).dot(normal) > 0)) {
+				throw InputError(face + " (merged within " + toleranceText() + ") is not convex at point " +
+				                 std::to_string(cycle[(k + 1) % cycle.size()]) + ": the block is too flat there");
+			}
+		}
+	}
 }
 
 // ---------------------------------------------------------------- step 6
@@ -351,19 +510,50 @@ void checkEuler(const ConvexPolyhedron& poly) {
 
 }  // namespace
 
+Vector3 faceNormal(const std::vector<Vector3>& vertices, const std::vector<int>& face) {
+	if (face.size() < 3) {
+		throw InputError("a face needs at least 3 corners, got " + std::to_string(face.size()));
+	}
+	Vector3 mean = Vector3::Zero();
+	for (int v : face) {
+		if (v < 0 || static_cast<std::size_t>(v) >= vertices.size()) {
+			throw InputError("face refers to vertex " + std::to_string(v) + " but there are " +
+			                 std::to_string(vertices.size()) + " vertices");
+		}
+		mean += vertices[v];
+	}
+	mean /= static_cast<double>(face.size());
+	Vector3 areaVector = Vector3::Zero();  // twice the vector area
+	for (std::size_t k = 0; k < face.size(); ++k) {
+		areaVector += (vertices[face[k]] - mean).cross(vertices[face[(k + 1) % face.size()]] - mean);
+	}
+	const double norm = areaVector.norm();
+	if (!(norm > 0) || !std::isfinite(norm)) {
+		throw InputError("the face with corners " + formatIndexList(face) + " has no well-defined normal (area " +
+		                 formatNumber(norm / 2) + ")");
+	}
+	return areaVector / norm;
+}
+
 ConvexPolyhedron buildConvexPolyhedron(const std::vector<Vector3>& points) {
 	requireEnoughPoints(points);
 	requireFiniteCoordinates(points);
 	requireDistinctPoints(points);
 	requireVolume(points);
+	const double tolerance = kCoplanarRelativeTolerance * boundingBoxDiagonal(points);
 
 	const std::vector<Triangle> triangles = hullTriangles(points);
-	const Facets facets = mergeCoplanarTriangles(points, triangles);
-	requireAllCorners(points, facets);
+	const Facets facets = growFacets(points, triangles, tolerance);
+	std::vector<std::vector<int>> cycles = facetBoundaries(triangles, facets);
+	requireAllCorners(points, facets, cycles, tolerance);
+	requireConvexFaces(points, facets, cycles);
 
 	ConvexPolyhedron poly;
 	poly.vertices = points;
-	poly.faces = faceCycles(triangles, facets);
+	// Each cycle starts at its smallest index; sorting makes the face order
+	// independent of the hull algorithm's internal order.
+	std::sort(cycles.begin(), cycles.end());
+	poly.faces = std::move(cycles);
 	buildEdges(poly);
 	checkEuler(poly);
 	return poly;

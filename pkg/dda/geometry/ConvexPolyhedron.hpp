@@ -2,10 +2,20 @@
 //
 // A DDA block is a convex polyhedron given by its vertices. Contact rules need
 // true polygonal faces and edges, not the triangles a hull algorithm returns, so
-// the builder merges coplanar hull triangles (decided with CGAL's exact
-// orientation predicate) into one polygon per plane and orients every polygon
-// counter-clockwise seen from outside. Geometry only: no physics here.
-// Units: whatever length unit the caller uses (SI metres in yade-dda).
+// the builder merges the hull triangles of one face plane into one polygon and
+// orients every polygon counter-clockwise seen from outside. Geometry only: no
+// physics here. Units: whatever length unit the caller uses (SI metres in
+// yade-dda).
+//
+// Faces are merged within a tolerance, not exactly. A box rotated by a general
+// angle, its corners rounded to double, has sides whose 4 corners are almost
+// never exactly coplanar; an exact merge would leave it with 12 triangles. So a
+// point counts as lying on a face plane when it is exactly coplanar with it, or
+// within kCoplanarRelativeTolerance x (bounding-box diagonal) of it. As a
+// consequence the faces of a block built from rounded input are nearly, not
+// exactly, planar: consumers must not take a face's plane from any 3 of its
+// corners, but from its Newell normal (faceNormal below) through the mean of
+// its corners.
 #pragma once
 
 #include <Eigen/Core>
@@ -18,6 +28,18 @@
 namespace dda {
 
 using Vector3 = Eigen::Vector3d;
+
+// Distance, as a fraction of the block's bounding-box diagonal, within which a
+// point lies on a face plane (dimensionless). Rule: rotating or translating
+// coordinates in double precision moves them by round-off of about 1e-16 x the
+// coordinate magnitude, i.e. about 1e-16 x (distance from the origin / block
+// size) relative to the block; 1e-9 stays far above that for blocks up to ~1e6
+// of their own size from the origin (a 1 mm block 1 km away), and far below any
+// real geometric feature of a rock block (1e-9 of a 1 m block is 1 nm). Two
+// faces meeting at a dihedral angle within ~1e-9 rad of 180 degrees are one
+// face; a corner closer than this to the plane of a face is rejected (the
+// block is too flat there), never silently dropped.
+inline constexpr double kCoplanarRelativeTolerance = 1e-9;
 
 // Raised for input that cannot be a DDA block. The message names the offending
 // point index and value, e.g. "point 7 (0.5, 0.5, 0.5) lies strictly inside the
@@ -32,7 +54,11 @@ struct ConvexPolyhedron {
 	// hull vertex, or construction fails).
 	std::vector<Vector3> vertices;
 	// One polygon per face plane: vertex indices, counter-clockwise seen from
-	// outside (so (v1-v0)x(v2-v0) points outward for a convex polygon).
+	// outside by the face's Newell normal, no vertex repeated, strictly convex
+	// (every corner turns left). Every corner of a face lies within
+	// kCoplanarRelativeTolerance x (bounding-box diagonal) of the plane of the
+	// face's largest hull triangle, hence within about twice that of the plane
+	// through the mean of its corners with normal faceNormal(vertices, face).
 	std::vector<std::vector<int>> faces;
 	// Each undirected edge once, with the two faces that share it:
 	// edges[e] = {a, b}, edgeFaces[e] = {f, g} where f traverses a->b and g b->a.
@@ -45,11 +71,26 @@ struct ConvexPolyhedron {
 //   - fewer than 4 points;
 //   - a coordinate is NaN or infinite (names point and coordinate);
 //   - two points coincide (names both indices);
-//   - all points are coplanar (zero volume);
-//   - a point is not a vertex of the hull: strictly inside (non-convex input) or
-//     on the hull surface without being a corner (names the index).
-// Face merging and all side-of tests use exact predicates, so the topology does
-// not depend on round-off.
+//   - all points are coplanar (zero volume, decided exactly);
+//   - a point is not a corner of the hull: strictly inside (non-convex input),
+//     or on the hull surface without being a corner, i.e. within the coplanar
+//     tolerance of the plane of one face (inside a face) or of two (inside an
+//     edge). A real corner that close to a face plane is rejected the same way,
+//     the message says the block is too flat there;
+//   - the block is thinner than the tolerance, or the hull triangles within
+//     the tolerance of one plane do not form one convex polygon.
+// The hull and the exact-coplanarity test use CGAL's exact predicates; the
+// tolerance test compares a double distance with the scaled tolerance. Each
+// face's plane is that of its largest hull triangle, fixed before the face is
+// grown, so a chain of slightly tilted triangles (a finely tessellated sphere)
+// never merges into one curved face.
 ConvexPolyhedron buildConvexPolyhedron(const std::vector<Vector3>& points);
+
+// Unit outward normal of a face by Newell's method (the polygon's vector area,
+// taken about the mean of its corners to limit round-off far from the origin).
+// Well defined for the nearly planar faces of buildConvexPolyhedron; outward
+// when the face is counter-clockwise seen from outside. Throws InputError for a
+// face with fewer than 3 corners, an index out of range, or zero area.
+Vector3 faceNormal(const std::vector<Vector3>& vertices, const std::vector<int>& face);
 
 }  // namespace dda

@@ -26,6 +26,14 @@ void assembleBlock(const Block& block, const IntegratorSettings& settings, doubl
 		system.force.noalias() += displacementMatrix(load.position - block.centroid).transpose() * load.force;
 }
 
+Vector12 solveBlock(const Block& block, const BlockSystem& system) {
+	if (!block.fixedPoints.empty()) return system.stiffness.llt().solve(system.force);
+	Vector12 D;
+	D.head<3>() = system.force.head<3>().cwiseQuotient(system.stiffness.diagonal().head<3>());
+	D.tail<9>() = system.stiffness.block<9, 9>(3, 3).llt().solve(system.force.tail<9>());
+	return D;
+}
+
 double largestVertexDisplacement(const Block& block, const Vector12& D) {
 	double largest = 0;
 	for (const Vector3& x : block.vertices)

@@ -32,6 +32,11 @@ inline Vector12 startVelocity(const Block& block, const IntegratorSettings& sett
 
 void assembleBlock(const Block& block, const IntegratorSettings& settings, double dt, BlockSystem& system);
 
+// Solves the block's system. Without fixed points the translations decouple
+// (the first moments about the centroid vanish), leaving a 3x3 diagonal and a
+// 9x9 system; otherwise the full 12x12 one. Both by Cholesky (K is SPD).
+Vector12 solveBlock(const Block& block, const BlockSystem& system);
+
 // Largest displacement of a vertex for the unknowns D [m].
 double largestVertexDisplacement(const Block& block, const Vector12& D);
 

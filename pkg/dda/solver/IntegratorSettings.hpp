@@ -16,7 +16,7 @@ struct IntegratorSettings {
 	double velocityRatio = 1;
 	// Largest vertex displacement allowed in one step [m]. When <= 0 it is
 	// maxDisplacementRatio x half the largest extent of the scene's bounding box
-	// (Shi's g2 x w0), measured when the step starts.
+	// (Shi's g2 x w0), measured at the first step after blocks were added.
 	double maxDisplacement = 0;
 	double maxDisplacementRatio = 0.01;  // [-], > 0
 	// A step whose largest displacement d exceeds the allowed a is redone with

@@ -13,6 +13,9 @@ namespace dda {
 
 namespace {
 using Clock = std::chrono::steady_clock;
+// Per-block loops run in parallel only from this many blocks on: waking an
+// OpenMP team costs tens of microseconds, more than a few blocks' work.
+constexpr int kMinBlocksForThreads = 64;
 double secondsSince(Clock::time_point start) {
 	return std::chrono::duration<double>(Clock::now() - start).count();
 }
@@ -81,11 +84,15 @@ void World::setStress(int index, const Vector6& stress) {
 	block(index).stress = stress;
 }
 
-double World::sceneHalfSize() const {
-	Eigen::AlignedBox3d box;
-	for (const Block& b : blocks_)
-		for (const Vector3& x : b.vertices) box.extend(x);
-	return box.isEmpty() ? 0.0 : 0.5 * box.sizes().maxCoeff();
+double World::sceneHalfSize() {
+	if (sceneSizedBlocks_ != blockCount()) {
+		Eigen::AlignedBox3d box;
+		for (const Block& b : blocks_)
+			for (const Vector3& x : b.vertices) box.extend(x);
+		sceneHalfSize_ = box.isEmpty() ? 0.0 : 0.5 * box.sizes().maxCoeff();
+		sceneSizedBlocks_ = blockCount();
+	}
+	return sceneHalfSize_;
 }
 
 void World::validateSettings(const IntegratorSettings& s) const {
@@ -137,15 +144,15 @@ double World::step(const IntegratorSettings& settings) {
 
 	for (int attempt = 0;; ++attempt) {
 		auto phase = Clock::now();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= kMinBlocksForThreads)
 		for (int k = 0; k < n; ++k) assembleBlock(blocks_[moving_[k]], settings, dt, systems_[k]);
 		stats.timeAssembly += secondsSince(phase);
 
 		phase = Clock::now();
 		double largest = 0;
-#pragma omp parallel for schedule(static) reduction(max : largest)
+#pragma omp parallel for schedule(static) reduction(max : largest) if (n >= kMinBlocksForThreads)
 		for (int k = 0; k < n; ++k) {
-			solutions_[k] = systems_[k].stiffness.llt().solve(systems_[k].force);
+			solutions_[k] = solveBlock(blocks_[moving_[k]], systems_[k]);
 			largest = std::max(largest, largestVertexDisplacement(blocks_[moving_[k]], solutions_[k]));
 		}
 		stats.timeSolve += secondsSince(phase);
@@ -168,7 +175,7 @@ double World::step(const IntegratorSettings& settings) {
 	}
 
 	const auto phase = Clock::now();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= kMinBlocksForThreads)
 	for (int k = 0; k < n; ++k) applyStep(blocks_[moving_[k]], solutions_[k], startVelocities_[k], dt);
 	stats.timeUpdate = secondsSince(phase);
 

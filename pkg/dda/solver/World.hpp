@@ -30,8 +30,9 @@ public:
 	const StepStatistics& lastStep() const { return stats_; }
 	double time() const { return time_; }
 	long steps() const { return steps_; }
-	// Half the largest extent of the bounding box of all blocks [m].
-	double sceneHalfSize() const;
+	// Half the largest extent of the bounding box of all blocks [m] (Shi's w0),
+	// measured at the first step after blocks were added.
+	double sceneHalfSize();
 
 private:
 	void validateSettings(const IntegratorSettings& settings) const;
@@ -41,6 +42,8 @@ private:
 	double time_ = 0;
 	long steps_ = 0;
 	long displacementLimitMisses_ = 0;
+	double sceneHalfSize_ = 0;
+	int sceneSizedBlocks_ = -1;  // block count when sceneHalfSize_ was measured
 	// per-step work arrays, kept to avoid reallocation
 	std::vector<int> moving_;
 	std::vector<BlockSystem> systems_;
