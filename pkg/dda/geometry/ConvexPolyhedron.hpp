@@ -42,8 +42,8 @@ using Vector3 = Eigen::Vector3d;
 inline constexpr double kCoplanarRelativeTolerance = 1e-9;
 
 // Raised for input that cannot be a DDA block. The message names the offending
-// point index and value, e.g. "point 7 (0.5, 0.5, 0.5) lies strictly inside the
-// convex hull of the others (non-convex input)".
+// point index and value, e.g. "point 8 (0.5, 0.5, 0.5) lies strictly inside the
+// hull of the others: the input is not convex".
 class InputError : public std::invalid_argument {
 public:
 	using std::invalid_argument::invalid_argument;

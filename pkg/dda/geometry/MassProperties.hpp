@@ -18,7 +18,11 @@ struct MassProperties {
 };
 
 // Faces must be closed and oriented outward (as buildConvexPolyhedron returns);
-// for a convex polygon the fan triangulation is used.
+// for a convex polygon the fan triangulation is used. Faces from rounded input
+// are nearly, not exactly, planar (within kCoplanarRelativeTolerance x size,
+// see ConvexPolyhedron.hpp): the fan triangles of neighbouring faces still share
+// their edges, so the integrals are those of that closed triangulated surface,
+// which differs from the block by at most that tolerance x its surface area.
 MassProperties computeMassProperties(const std::vector<Vector3>& vertices,
                                      const std::vector<std::vector<int>>& faces);
 
