@@ -38,15 +38,16 @@ def run(n, steps, syncPeriod, threads):
     buildTime = build(n)
     O.engines = [DDAIntegrator(dt=1e-3, gravity=(0, 0, -9.81), syncPeriod=syncPeriod, threads=threads, label='dda')]
     O.run(1, True)  # first step links the bodies: not timed
-    syncBefore = yade_dda.stats()['syncTimeTotal']
+    before = yade_dda.stats()
     start = time.perf_counter()
     O.run(steps, True)
     wall = time.perf_counter() - start
     s = yade_dda.stats()
-    core = s['time']['core']
-    sync = s['syncTimeTotal'] - syncBefore
+    sync = s['syncTimeTotal'] - before['syncTimeTotal']
+    engine = s['stepTimeTotal'] - before['stepTimeTotal']
     return dict(blocks=n, steps=steps, syncPeriod=syncPeriod, threads=threads,
-                wallPerStep=wall / steps, corePerStepLast=core, syncPerStep=sync / steps,
+                wallPerStep=wall / steps, enginePerStep=engine / steps, corePerStep=(engine - sync) / steps,
+                syncPerStep=sync / steps, corePerStepLast=s['time']['core'],
                 syncShare=sync / wall, syncs=s['syncs'], buildSeconds=buildTime,
                 peakRssMB=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)
 
@@ -63,8 +64,10 @@ def main():
         for syncPeriod in (0, 1):
             row = run(n, args.steps, syncPeriod, args.threads)
             rows.append(row)
-            print('%6d blocks, sync %-6s: %8.2f ms/step (core %6.2f ms, sync %6.2f ms = %4.1f%%), build %.1f s, peak RSS %.0f MB'
-                  % (n, 'auto' if syncPeriod == 0 else 'every', 1e3 * row['wallPerStep'], 1e3 * row['corePerStepLast'],
+            print('%6d blocks, sync %-6s: %8.2f ms/step (DDA engine %6.2f ms: core %6.2f ms, sync %6.2f ms = %4.1f%%), '
+                  'build %.1f s, peak RSS %.0f MB'
+                  % (n, 'auto' if syncPeriod == 0 else 'every', 1e3 * row['wallPerStep'], 1e3 * row['enginePerStep'],
+                     1e3 * row['corePerStep'],
                      1e3 * row['syncPerStep'], 100 * row['syncShare'], row['buildSeconds'], row['peakRssMB']))
     os.makedirs(os.path.dirname(args.out), exist_ok=True)
     with open(args.out, 'w') as f:

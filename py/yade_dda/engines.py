@@ -219,6 +219,7 @@ def _checkEngines(scene, engines):
 
 def integratorStep(text):
     """One DDA step; called by DDAIntegrator's command every iteration with its parameters."""
+    start = time.perf_counter()
     params, settings = _parse(text)
     scene = _scene.current()
     before = len(scene.bodyOfBlock)
@@ -230,3 +231,4 @@ def integratorStep(text):
     O.dt = scene.core.step(settings)
     if _syncNeeded(params, engines):
         scene.sync()
+    scene.stepTimeTotal += time.perf_counter() - start

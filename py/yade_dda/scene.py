@@ -30,6 +30,7 @@ class DDAScene:
         self.syncedBodies = 0
         self.syncs = 0             # number of syncs done
         self.syncTimeTotal = 0.0   # wall time of all syncs [s]
+        self.stepTimeTotal = 0.0   # wall time of all engine calls, sync included [s]
         self.lastSyncIter = -1
         self.checkedEngines = None  # engine list last checked for conflicts
 
@@ -136,7 +137,8 @@ def stats():
     ``maxDisplacement`` and ``allowedDisplacement`` [m], ``blocks``,
     ``movingBlocks``, ``unknowns`` (system size), ``time`` (wall seconds per
     phase: assembly, solve, update, core, sync), ``syncedBodies`` and ``syncs``
-    (bodies written by the last sync, syncs so far), ``syncTimeTotal`` [s].
+    (bodies written by the last sync, syncs so far), ``syncTimeTotal`` and
+    ``stepTimeTotal`` [s] (all syncs; all integrator calls, sync included).
     """
     scene = _require()
     result = scene.core.lastStep()
@@ -144,6 +146,7 @@ def stats():
     result['syncedBodies'] = scene.syncedBodies
     result['syncs'] = scene.syncs
     result['syncTimeTotal'] = scene.syncTimeTotal
+    result['stepTimeTotal'] = scene.stepTimeTotal
     result['pendingBodies'] = sum(1 for body, _ in scene.pending if body.id >= 0)
     result['steps'] = scene.core.steps()
     return result
