@@ -225,9 +225,11 @@ def integratorStep(text):
     before = len(scene.bodyOfBlock)
     scene.resolvePending()
     engines = O.engines
-    if len(scene.bodyOfBlock) != before or scene.checkedEngines != len(engines):
+    signature = tuple((type(e).__name__, e.mask) if isinstance(e, wrapper.NewtonIntegrator) else type(e).__name__
+                      for e in engines)
+    if len(scene.bodyOfBlock) != before or scene.checkedEngines != signature:
         _checkEngines(scene, engines)
-        scene.checkedEngines = len(engines)
+        scene.checkedEngines = signature
     O.dt = scene.core.step(settings)
     if _syncNeeded(params, engines):
         scene.sync()

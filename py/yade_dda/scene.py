@@ -32,7 +32,7 @@ class DDAScene:
         self.syncTimeTotal = 0.0   # wall time of all syncs [s]
         self.stepTimeTotal = 0.0   # wall time of all engine calls, sync included [s]
         self.lastSyncIter = -1
-        self.checkedEngines = None  # engine list last checked for conflicts
+        self.checkedEngines = None  # signature of the engine list last checked for conflicts
 
     def register(self, body, spec):
         self.pending.append((body, spec))

@@ -123,3 +123,14 @@ def test_stats_report_phases_and_sizes(scene):
     assert s['dt'] == O.dt
     # the allowed displacement is ratio x half the scene size (0.01 x 0.5 m)
     assert abs(s['allowedDisplacement'] - 0.005) < 1e-15
+
+
+def test_newton_added_or_changed_mid_run_is_checked_again(scene):
+    O.bodies.append(ddaBlock(box((0, 0, 0), (1, 1, 1)), mask=2))
+    newton = wrapper.NewtonIntegrator(gravity=(0, 0, -G), mask=1)
+    O.engines = [newton, DDAIntegrator(dt=1e-3, label='dda')]
+    O.step()
+    newton.mask = 3
+    with pytest.raises(RuntimeError) as error:
+        O.step()
+    assert 'NewtonIntegrator would also move' in str(error.value)

@@ -34,6 +34,7 @@
 #include "dda/geometry/ConvexPolyhedron.hpp"
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include <vector>
 
