@@ -13,6 +13,7 @@ import time
 from ._yade import O, wrapper
 from . import _core
 from . import scene as _scene
+from .blocks import _vector
 
 
 def _finite(name, value, low=None, high=None, lowOpen=False, unit=''):
@@ -48,12 +49,7 @@ class _Parameter:
 
 
 def _vector3(name):
-    def check(value):
-        values = tuple(float(x) for x in value)
-        if len(values) != 3 or not all(math.isfinite(x) for x in values):
-            raise ValueError('%s must be 3 finite numbers, got %r' % (name, value))
-        return values
-    return check
+    return lambda value: _vector(value, name)
 
 
 class DDAIntegrator(wrapper.PyRunner):

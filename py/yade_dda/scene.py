@@ -218,16 +218,3 @@ def addFixedPoint(body, point, stiffness=0):
     """Holds the material point now at point [m] with a penalty spring [N/m] (0: default)."""
     scene = _require()
     scene.core.addFixedPoint(scene.blockIndex(body), point, stiffness)
-
-
-def dataFor(bodies=None):
-    """Positions [m] and velocities [m/s] of DDA bodies straight from the core, without a sync."""
-    scene = _require()
-    scene.resolvePending()
-    ids = bodies if bodies is not None else scene.bodyOfBlock
-    out = {}
-    for bodyId in ids:
-        index = scene.blockIndex(bodyId)
-        v = scene.core.velocity(index)
-        out[bodyId] = (scene.core.centroid(index), v[:3])
-    return out

@@ -134,3 +134,25 @@ def test_newton_added_or_changed_mid_run_is_checked_again(scene):
     with pytest.raises(RuntimeError) as error:
         O.step()
     assert 'NewtonIntegrator would also move' in str(error.value)
+
+
+def test_script_helpers_change_a_running_block(scene):
+    body = O.bodies.append(ddaBlock(box((0, 0, 0), (1, 1, 1)), material=material(O, density=1000)))
+    sphere = O.bodies.append(utils.sphere((5, 5, 5), 0.5))
+    O.engines = [DDAIntegrator(dt=1e-3, maxDisplacement=1, label='dda')]
+    O.run(10, True)
+    assert yade_dda.blockOf(body) == 0 and yade_dda.blockOf(sphere) is None
+    with pytest.raises(KeyError, match='not a DDA block'):
+        yade_dda.block(sphere)
+    yade_dda.setVelocity(body, (0, 0, 2))
+    t0 = O.time
+    O.run(100, True)
+    assert abs(O.bodies[body].state.pos[2] - (0.5 + 2 * (O.time - t0))) < 1e-12
+    # a 1 kN load at the centroid of the 1000 kg block: 1 m/s^2 from now on
+    yade_dda.setVelocity(body, (0, 0, 0))
+    z0, t0 = O.bodies[body].state.pos[2], O.time
+    yade_dda.addPointLoad(body, O.bodies[body].state.pos, (0, 0, 1000))
+    O.run(200, True)
+    assert abs(O.bodies[body].state.pos[2] - (z0 + 0.5 * (O.time - t0) ** 2)) < 1e-12
+    with pytest.raises(ValueError, match='finite'):
+        yade_dda.addPointLoad(body, (0, 0, float('nan')), (0, 0, 1))
