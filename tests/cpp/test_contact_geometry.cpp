@@ -212,9 +212,16 @@ TEST(ContactEdgeEdge, CrossingEdgesAtManyAnglesMatchClosedForm) {
 					const dda::EdgeEdgeResult r = dda::edgeEdgeDistance(
 					    place(c.p1), place(c.p2), place(c.p3), place(c.p4), side * (place.R * Vector3::UnitZ()), 1e-9,
 					    angleTolerance);
-					// Round-off: ~1e-16 of the coordinates, amplified by 1/sin(theta).
+					// Conditioning: a point error delta in the plane of the edges moves the
+					// closest points by ~delta/sin(theta); a tilt alpha of an edge out of
+					// that plane turns n by ~alpha/sin(theta), which moves them by
+					// ~h alpha/sin(theta)^2. Unmoved, the edges are exactly parallel to
+					// z = 0 (no tilt) and delta ~1e-16; placed 1 km away, delta and
+					// alpha are ~1e-13 (m, rad).
+					const double sine = std::sin(theta);
 					const double base = place.o.norm() > 0 ? 1e-12 : 1e-15;
-					const double positionTolerance = base / std::sin(theta) + base;
+					const double tilt = place.o.norm() > 0 ? std::abs(h) / (sine * sine) : 0.0;
+					const double positionTolerance = base * (1 / sine + tilt + 1);
 					EXPECT_FALSE(r.parallel);
 					EXPECT_FALSE(r.degenerate);
 					EXPECT_TRUE(r.interior);

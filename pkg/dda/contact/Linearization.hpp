@@ -4,8 +4,8 @@
 // Stencil. A contact is described by four points Q1..Q4 [m]:
 //   - vertex-face: Q1 the vertex of block i; Q2, Q3, Q4 three corners of the
 //     face of block j, counter-clockwise seen from outside block j (any three
-//     consecutive-order corners of a face of buildConvexPolyhedron; see
-//     chooseFaceCorners for the best-conditioned choice);
+//     corners of a face of buildConvexPolyhedron taken in the face's cyclic
+//     order; chooseFaceCorners gives the best-conditioned choice);
 //   - edge-edge: Q1, Q2 the endpoints of the edge of block i; Q3, Q4 those of
 //     the edge of block j.
 // With the 4x4 determinant
