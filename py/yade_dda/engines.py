@@ -129,10 +129,8 @@ class DDAIntegrator(wrapper.PyRunner):
         return {name: cls.__dict__[name].default for name in cls._names}
 
     def _updateCommand(self):
-        # The parameters travel as one string literal: YADE compiles the command
-        # every step, and a string compiles in a few microseconds where the
-        # equivalent dict display takes tens.
-        # Only values that differ from the defaults are written, to keep it short.
+        # Parameters that differ from the defaults travel as one string literal,
+        # parsed once per distinct string (see _parse) and cached.
         defaults = self._defaults()
         changed = {k: v for k, v in self._params.items() if v != defaults[k]}
         self.command = 'import yade_dda.engines as _dda; _dda.integratorStep(%r)' % (repr(changed),)
@@ -203,7 +201,7 @@ def _checkEngines(scene, engines):
     """Refuses engine lists that would move DDA blocks twice."""
     for engine in engines:
         if isinstance(engine, wrapper.NewtonIntegrator):
-            for index, bodyId in enumerate(scene.bodyOfBlock):
+            for bodyId in scene.bodyOfBlock:
                 body = O.bodies[bodyId]
                 if body is not None and body.dynamic and (engine.mask & body.groupMask):
                     raise RuntimeError(
