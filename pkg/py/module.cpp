@@ -15,27 +15,21 @@ using namespace dda;
 
 namespace {
 
-std::vector<Vector3> toPoints(const py::object& sequence, const char* what) {
-	std::vector<Vector3> points;
-	const long n = py::len(sequence);
-	points.reserve(n);
-	for (long i = 0; i < n; ++i) {
-		py::object item = sequence[i];
-		if (py::len(item) != 3) {
-			PyErr_Format(PyExc_ValueError, "%s: point %ld does not have 3 coordinates", what, i);
-			py::throw_error_already_set();
-		}
-		points.emplace_back(py::extract<double>(item[0])(), py::extract<double>(item[1])(), py::extract<double>(item[2])());
-	}
-	return points;
-}
-
 Vector3 toVector(const py::object& item, const char* what) {
 	if (py::len(item) != 3) {
 		PyErr_Format(PyExc_ValueError, "%s must have 3 components", what);
 		py::throw_error_already_set();
 	}
 	return Vector3(py::extract<double>(item[0])(), py::extract<double>(item[1])(), py::extract<double>(item[2])());
+}
+
+std::vector<Vector3> toPoints(const py::object& sequence, const char* what) {
+	std::vector<Vector3> points;
+	const long n = py::len(sequence);
+	points.reserve(n);
+	for (long i = 0; i < n; ++i)
+		points.push_back(toVector(sequence[i], (std::string(what) + ": point " + std::to_string(i)).c_str()));
+	return points;
 }
 
 template <class Vector>
