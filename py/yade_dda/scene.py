@@ -31,7 +31,6 @@ class DDAScene:
         self.syncs = 0             # number of syncs done
         self.syncTimeTotal = 0.0   # wall time of all syncs [s]
         self.stepTimeTotal = 0.0   # wall time of all engine calls, sync included [s]
-        self.lastSyncIter = -1
         self.checkedEngines = None  # signature of the engine list last checked for conflicts
 
     def register(self, body, spec):
@@ -92,7 +91,6 @@ class DDAScene:
         self.syncTimeTotal += self.syncTime
         self.syncedBodies = len(data)
         self.syncs += 1
-        self.lastSyncIter = O.iter
 
 
 def current(create=True):
