@@ -45,14 +45,29 @@ py::list toList(const std::vector<Vector3>& points) {
 	return out;
 }
 
-int addBlock(SceneLink& scene, const py::object& points, double density, double young, double poisson, bool fixed) {
-	return scene.world.addBlock(toPoints(points, "block vertices"), Material{density, young, poisson}, fixed);
+int addBlock(SceneLink& scene, const py::object& points, double density, double young, double poisson,
+             double frictionAngle, bool fixed) {
+	return scene.world.addBlock(toPoints(points, "block vertices"), Material{density, young, poisson, frictionAngle},
+	                            fixed);
 }
 
 // Validates a block without adding it (ddaBlock calls this before making a body).
-void checkBlock(const py::object& points, double density, double young, double poisson) {
-	validateMaterial(Material{density, young, poisson});
+void checkBlock(const py::object& points, double density, double young, double poisson, double frictionAngle) {
+	validateMaterial(Material{density, young, poisson, frictionAngle});
 	buildConvexPolyhedron(toPoints(points, "block vertices"));
+}
+
+// One tuple per sub-contact: (block i, block j, kind, structural type, state,
+// normal from j to i, point, normal force [N], shear force on i [N], gap at the
+// start of the step [m]).
+py::list contactList(const SceneLink& s) {
+	py::list out;
+	for (const Contact& c : s.world.contacts()) {
+		out.append(py::make_tuple(c.key.blockI, c.key.blockJ, c.key.kind == ContactKind::VertexFace ? "VF" : "EE",
+		                          contactTypeName(c.pairType), contactStateName(c.history.state), c.geometry.normal,
+		                          c.point, c.history.normalForce, c.history.shearForce, c.geometry.gap));
+	}
+	return out;
 }
 
 void linkBody(SceneLink& scene, int block, int bodyId, const Eigen::Quaterniond& orientation, const py::object& localVertices) {
@@ -157,7 +172,23 @@ py::dict lastStep(const SceneLink& s) {
 	d["blocks"] = st.blocks;
 	d["movingBlocks"] = st.movingBlocks;
 	d["unknowns"] = st.unknowns;
+	d["contactDistance"] = st.contactDistance;
+	d["candidatePairs"] = st.candidatePairs;
+	d["contactPairs"] = st.contactPairs;
+	d["contacts"] = st.contacts;
+	d["closedContacts"] = st.closedContacts;
+	d["slidingContacts"] = st.slidingContacts;
+	d["openCloseIterations"] = st.openCloseIterations;
+	d["openCloseIterationsTotal"] = st.openCloseIterationsTotal;
+	d["stateChanges"] = st.stateChanges;
+	d["openCloseCuts"] = st.openCloseCuts;
+	d["openCloseFailures"] = st.openCloseFailures;
+	d["maxPenetration"] = st.maxPenetration;
+	d["components"] = st.components;
+	d["largestComponent"] = st.largestComponent;
 	py::dict times;
+	times["broadPhase"] = st.timeBroadPhase;
+	times["narrowPhase"] = st.timeNarrowPhase;
 	times["assembly"] = st.timeAssembly;
 	times["solve"] = st.timeSolve;
 	times["update"] = st.timeUpdate;
@@ -176,7 +207,8 @@ py::object bodyToBlock(const SceneLink& s, int bodyId) {
 BOOST_PYTHON_MODULE(_core) {
 	py::docstring_options options(true, true, false);
 
-	py::def("checkBlock", &checkBlock, (py::arg("points"), py::arg("density"), py::arg("young"), py::arg("poisson")),
+	py::def("checkBlock", &checkBlock,
+	        (py::arg("points"), py::arg("density"), py::arg("young"), py::arg("poisson"), py::arg("frictionAngle") = 0.0),
 	        "Raises ValueError naming the problem if the points and material cannot make a DDA block.");
 
 	py::class_<IntegratorSettings>("IntegratorSettings", "Parameters of one DDA step (see DDAIntegrator for units and meaning).")
@@ -191,10 +223,20 @@ BOOST_PYTHON_MODULE(_core) {
 	    .def_readwrite("timeStepGrowth", &IntegratorSettings::timeStepGrowth)
 	    .def_readwrite("maxStepCuts", &IntegratorSettings::maxStepCuts)
 	    .def_readwrite("fixedPointPenaltyFactor", &IntegratorSettings::fixedPointPenaltyFactor)
+	    .def_readwrite("contactDistance", &IntegratorSettings::contactDistance)
+	    .def_readwrite("contactDistanceFactor", &IntegratorSettings::contactDistanceFactor)
+	    .def_readwrite("contactPenaltyFactor", &IntegratorSettings::contactPenaltyFactor)
+	    .def_readwrite("shearStiffnessRatio", &IntegratorSettings::shearStiffnessRatio)
+	    .def_readwrite("maxOpenCloseIterations", &IntegratorSettings::maxOpenCloseIterations)
+	    .def_readwrite("openCloseShrink", &IntegratorSettings::openCloseShrink)
+	    .def_readwrite("openCloseTolerance", &IntegratorSettings::openCloseTolerance)
 	    .def_readwrite("threads", &IntegratorSettings::threads);
 
 	py::class_<SceneLink, boost::noncopyable>("Scene", "The DDA state of one YADE scene; the core is the source of truth.")
-	    .def("addBlock", &addBlock, (py::arg("points"), py::arg("density"), py::arg("young"), py::arg("poisson"), py::arg("fixed")))
+	    .def("addBlock", &addBlock,
+	         (py::arg("points"), py::arg("density"), py::arg("young"), py::arg("poisson"), py::arg("frictionAngle"),
+	          py::arg("fixed")))
+	    .def("contacts", &contactList)
 	    .def("linkBody", &linkBody)
 	    .def("blockOfBody", &bodyToBlock)
 	    .def("blockCount", &SceneLink::blockCount)

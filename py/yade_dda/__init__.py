@@ -16,7 +16,7 @@ from ._yade import O
 from .blocks import ddaBlock
 from .engines import DDAIntegrator
 from .scene import (stats, sync, block, blockOf, setVelocity, addPointLoad, addFixedPoint,
-                    printStats)
+                    printStats, contacts)
 
 __all__ = ['ddaBlock', 'DDAIntegrator', 'stats', 'printStats', 'sync', 'block', 'blockOf',
-           'setVelocity', 'addPointLoad', 'addFixedPoint', 'O']
+           'setVelocity', 'addPointLoad', 'addFixedPoint', 'contacts', 'O']

@@ -9,7 +9,7 @@ from . import scene as _scene
 class BlockSpec:
     """What the core needs to build a block once its body is in O.bodies."""
 
-    __slots__ = ('points', 'density', 'young', 'poisson', 'fixed', 'fixedPoints', 'loads', 'stress')
+    __slots__ = ('points', 'density', 'young', 'poisson', 'frictionAngle', 'fixed', 'fixedPoints', 'loads', 'stress')
 
     def __init__(self, **kw):
         for key in self.__slots__:
@@ -71,7 +71,9 @@ def _elasticConstants(material):
     if missing:
         raise TypeError('material %s has no %s; use PolyhedraMat (or another elastic material)'
                         % (type(material).__name__, ', '.join(missing)))
-    return float(material.density), float(material.young), float(material.poisson)
+    # Materials without friction (plain ElastMat) make frictionless joints.
+    friction = float(getattr(material, 'frictionAngle', 0.0))
+    return float(material.density), float(material.young), float(material.poisson), friction
 
 
 def ddaBlock(vertices, material=None, fixed=False, color=None, velocity=(0, 0, 0),
@@ -88,6 +90,10 @@ def ddaBlock(vertices, material=None, fixed=False, color=None, velocity=(0, 0, 0
     :param material: a ``PolyhedraMat`` (or other elastic material with
         ``young`` [Pa], ``poisson`` and ``density`` [kg/m^3]), its id in
         ``O.materials`` or its label; None makes a default ``PolyhedraMat``.
+        Its ``frictionAngle`` [rad] is the joint friction of the block's
+        contacts (a contact takes the smaller angle of its two blocks). Note
+        YADE's default ``frictionAngle`` is 0.5 rad; set 0 for frictionless
+        joints.
     :param fixed: a fixed block never moves and has no unknowns.
     :param velocity: initial velocity of the centroid [m/s].
     :param angularVelocity: initial angular velocity [rad/s].
@@ -109,8 +115,8 @@ def ddaBlock(vertices, material=None, fixed=False, color=None, velocity=(0, 0, 0
     """
     points = _points(vertices)
     mat = _material(material)
-    density, young, poisson = _elasticConstants(mat)
-    _core.checkBlock(points, density, young, poisson)
+    density, young, poisson, frictionAngle = _elasticConstants(mat)
+    _core.checkBlock(points, density, young, poisson, frictionAngle)
     velocity = _vector(velocity, 'velocity')
     angularVelocity = _vector(angularVelocity, 'angularVelocity')
     if fixed and (any(velocity) or any(angularVelocity)):
@@ -136,7 +142,8 @@ def ddaBlock(vertices, material=None, fixed=False, color=None, velocity=(0, 0, 0
     if not fixed:
         body.state.vel = velocity
         body.state.angVel = angularVelocity
-    spec = BlockSpec(points=points, density=density, young=young, poisson=poisson, fixed=bool(fixed),
+    spec = BlockSpec(points=points, density=density, young=young, poisson=poisson, frictionAngle=frictionAngle,
+                     fixed=bool(fixed),
                      fixedPoints=fixedList, loads=loadList, stress=stress)
     _scene.current().register(body, spec)
     return body

@@ -53,17 +53,24 @@ def _vector3(name):
 
 
 class DDAIntegrator(wrapper.PyRunner):
-    """Shi's implicit DDA time integration of all DDA blocks (replaces NewtonIntegrator).
+    """Shi's implicit DDA time integration of all DDA blocks, with their contacts
+    (replaces NewtonIntegrator, and YADE's collider and contact laws).
 
     Each step solves, for the 12 unknowns D of every moving block
     (translation, rotation, strain; Wu et al. 2014 Eq. 1-6),
     ``K D = F`` with inertia ``(2/dt^2) M D = (2/dt) M v0`` (constant
     acceleration over the step), elastic stiffness ``V E``, the stress of the
-    previous step, gravity, fixed-point penalty springs and point loads; then
-    moves each block by an exact rotation about its centroid followed by the
-    strain, sets ``v1 = 2 D / dt - v0`` and adds ``E * strain`` to the stress.
-    A step whose largest vertex displacement exceeds the allowed one is redone
-    with a smaller dt. ``O.dt`` and ``O.time`` follow the step actually taken.
+    previous step, gravity, fixed-point penalty springs, point loads and the
+    contacts: vertex-face and edge-edge sub-contacts within the contact
+    distance, each with a normal penalty spring when closed, a shear spring
+    when locked and Coulomb friction when sliding (Eq. 7-9). The open-close
+    iteration repeats the solve until no contact changes state; if that takes
+    more than ``maxOpenCloseIterations`` solves, the step is redone with
+    ``dt x openCloseShrink``. Then each block moves by an exact rotation about
+    its centroid followed by the strain, ``v1 = 2 D / dt - v0``, and the
+    stress gains ``E * strain``. A step whose largest vertex displacement
+    exceeds the allowed one is redone with a smaller dt. ``O.dt`` and
+    ``O.time`` follow the step actually taken.
 
     Parameters (SI units):
 
@@ -80,6 +87,16 @@ class DDAIntegrator(wrapper.PyRunner):
     - ``fixedPointPenaltyFactor`` [-]: default fixed-point stiffness is this x E x
       block size (cube root of the volume).
     - ``threads``: worker threads for the core, 0 = all; results do not depend on it.
+    - ``contactDistance`` [m]: d0, within which features become contacts; 0
+      (default) = 2.5 x the allowed step displacement (Shi's rule).
+    - ``contactPenaltyFactor`` [-]: normal contact stiffness [N/m] is this x
+      the smaller E x size of the two blocks (default 40; Shi: 40-100 x E).
+    - ``shearStiffnessRatio`` [-]: shear / normal contact stiffness (0.4).
+    - ``maxOpenCloseIterations``: solves per step before dt is cut (6).
+    - ``openCloseShrink`` [-]: dt factor for a step whose iteration did not
+      converge (0.3).
+    - ``openCloseTolerance`` [-]: a closed contact opens when its gap exceeds
+      this x the allowed step displacement (1e-9).
     - ``syncPeriod``: write the DDA state into YADE's bodies every n steps; 0
       (default) = when something may read it: the last step of ``O.run(n)``,
       ``O.step()``, a step after which another periodic engine (a PyRunner
@@ -104,9 +121,23 @@ class DDAIntegrator(wrapper.PyRunner):
                                          'default fixed-point stiffness / (E x block size) [-]')
     threads = _Parameter(0, lambda v: int(_finite('threads', v, 0)), 'core threads, 0 = all')
     syncPeriod = _Parameter(0, lambda v: int(_finite('syncPeriod', v, 0)), 'steps between syncs, 0 = automatic')
+    contactDistance = _Parameter(0.0, lambda v: _finite('contactDistance', v, 0, unit=' m'),
+                                 'contact distance d0 [m]; 0 = 2.5 x allowed step displacement')
+    contactPenaltyFactor = _Parameter(40.0, lambda v: _finite('contactPenaltyFactor', v, 0, lowOpen=True),
+                                      'contact normal stiffness / min(E x block size) [-]')
+    shearStiffnessRatio = _Parameter(0.4, lambda v: _finite('shearStiffnessRatio', v, 0),
+                                     'contact shear / normal stiffness [-]')
+    maxOpenCloseIterations = _Parameter(6, lambda v: int(_finite('maxOpenCloseIterations', v, 1)),
+                                        'open-close iterations before dt is cut')
+    openCloseShrink = _Parameter(0.3, lambda v: _finite('openCloseShrink', v, 0, 0.99, lowOpen=True),
+                                 'dt factor when the open-close iteration does not converge [-]')
+    openCloseTolerance = _Parameter(1e-9, lambda v: _finite('openCloseTolerance', v, 0),
+                                    'opening gap of a closed contact / allowed step displacement [-]')
 
     _names = ('dt', 'gravity', 'velocityRatio', 'maxDisplacement', 'maxDisplacementRatio', 'timeStepGrowth',
-              'maxStepCuts', 'fixedPointPenaltyFactor', 'threads', 'syncPeriod')
+              'maxStepCuts', 'fixedPointPenaltyFactor', 'threads', 'syncPeriod', 'contactDistance',
+              'contactPenaltyFactor', 'shearStiffnessRatio', 'maxOpenCloseIterations', 'openCloseShrink',
+              'openCloseTolerance')
 
     def __init__(self, label='', **params):
         wrapper.PyRunner.__init__(self)
@@ -160,6 +191,12 @@ def _settings(params):
     settings.maxStepCuts = params['maxStepCuts']
     settings.fixedPointPenaltyFactor = params['fixedPointPenaltyFactor']
     settings.threads = params['threads']
+    settings.contactDistance = params['contactDistance']
+    settings.contactPenaltyFactor = params['contactPenaltyFactor']
+    settings.shearStiffnessRatio = params['shearStiffnessRatio']
+    settings.maxOpenCloseIterations = params['maxOpenCloseIterations']
+    settings.openCloseShrink = params['openCloseShrink']
+    settings.openCloseTolerance = params['openCloseTolerance']
     return settings
 
 

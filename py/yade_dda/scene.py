@@ -45,7 +45,8 @@ class DDAScene:
             if body.id < 0:
                 waiting.append((body, spec))   # made but not (yet) appended: not simulated
                 continue
-            index = self.core.addBlock(spec.points, spec.density, spec.young, spec.poisson, spec.fixed)
+            index = self.core.addBlock(spec.points, spec.density, spec.young, spec.poisson, spec.frictionAngle,
+                                       spec.fixed)
             self.core.linkBody(index, body.id, body.state.ori, list(body.shape.v))
             # The body's state is read here, so a script may still set
             # b.state.vel / b.state.angVel between ddaBlock() and the first step.
@@ -130,11 +131,22 @@ def sync(everything=True):
 def stats():
     """Diagnostics of the last DDA step as a dict.
 
-    Keys: ``dt`` [s] taken, ``stepCuts`` (redos with a smaller dt in that step),
-    ``displacementLimitMisses`` (cumulative steps accepted above the bound),
-    ``maxDisplacement`` and ``allowedDisplacement`` [m], ``blocks``,
-    ``movingBlocks``, ``unknowns`` (system size), ``time`` (wall seconds per
-    phase: assembly, solve, update, core, sync), ``syncedBodies`` and ``syncs``
+    Keys: ``dt`` [s] taken, ``stepCuts`` (redos with a smaller dt in that step,
+    for either reason below), ``displacementLimitMisses`` (cumulative steps
+    accepted above the bound), ``maxDisplacement`` and ``allowedDisplacement``
+    [m], ``blocks``, ``movingBlocks``, ``unknowns`` (system size).
+    Contacts: ``contactDistance`` [m] (d0 used), ``candidatePairs`` (block pairs
+    from the broad phase), ``contactPairs`` (pairs within d0), ``contacts``
+    (vertex-face and edge-edge sub-contacts), ``closedContacts``,
+    ``slidingContacts``, ``openCloseIterations`` (solves in the accepted
+    attempt), ``openCloseIterationsTotal`` (in all attempts),
+    ``stateChanges`` (changes left when the iteration stopped: 0 unless it
+    failed), ``openCloseCuts`` (dt cuts because the iteration did not
+    converge), ``openCloseFailures`` (cumulative steps accepted unconverged),
+    ``maxPenetration`` [m] (deepest closed contact), ``components`` and
+    ``largestComponent`` (independent systems solved, blocks in the largest).
+    ``time``: wall seconds per phase: broadPhase, narrowPhase, assembly,
+    solve, update, core, sync. ``syncedBodies`` and ``syncs``
     (bodies written by the last sync, syncs so far), ``syncTimeTotal`` and
     ``stepTimeTotal`` [s] (all syncs; all integrator calls, sync included).
     """
@@ -156,7 +168,11 @@ def printStats():
     print('DDA step: dt %.3e s, %d cuts, %d/%d moving blocks, %d unknowns, max displacement %.3e m (allowed %.3e m)'
           % (s['dt'], s['stepCuts'], s['movingBlocks'], s['blocks'], s['unknowns'], s['maxDisplacement'],
              s['allowedDisplacement']))
-    for phase in ('assembly', 'solve', 'update', 'core', 'sync'):
+    print('  contacts: %d pairs of %d candidates, %d sub-contacts (%d closed, %d sliding), '
+          '%d open-close iterations, %d cuts, max penetration %.3e m'
+          % (s['contactPairs'], s['candidatePairs'], s['contacts'], s['closedContacts'], s['slidingContacts'],
+             s['openCloseIterations'], s['openCloseCuts'], s['maxPenetration']))
+    for phase in ('broadPhase', 'narrowPhase', 'assembly', 'solve', 'update', 'core', 'sync'):
         print('  %-9s %10.3f ms' % (phase, 1e3 * s['time'][phase]))
 
 
@@ -181,6 +197,56 @@ class BlockView:
     rotation = property(lambda self: self._core.rotation(self.index), doc='rotation since creation (Quaternion)')
     fixed = property(lambda self: self._core.isFixed(self.index))
     fixedPoints = property(lambda self: self._core.fixedPoints(self.index), doc='current fixed-point positions [m]')
+
+
+class ContactView:
+    """One vertex-face or edge-edge sub-contact at the end of the last step (SI units).
+
+    ``id1``, ``id2``: body ids; id1 owns the vertex (kind 'VF') or the first
+    edge ('EE'), id2 the entrance face or the second edge. ``type``: the
+    structural type of the pair ('VV', 'VE', 'VF', 'EE', 'EEp', 'EF', 'FF').
+    ``state``: 'open', 'sliding' or 'locked'. ``normal``: unit, from id2
+    towards id1. ``point`` [m]: the contact point on id1. ``normalForce`` [N]:
+    compressive normal force (>= 0). ``shearForce`` [N]: tangential force on
+    id1 (shear spring when locked, friction when sliding). ``gap`` [m]: normal
+    distance at the start of the step (< 0 penetrating).
+    """
+
+    __slots__ = ('id1', 'id2', 'kind', 'type', 'state', 'normal', 'point', 'normalForce', 'shearForce', 'gap')
+
+    def __init__(self, *values):
+        for name, value in zip(self.__slots__, values):
+            setattr(self, name, value)
+
+    @property
+    def force(self):
+        """Total contact force on id1 [N]: normalForce along normal plus shearForce."""
+        return self.normal * self.normalForce + self.shearForce
+
+    def __repr__(self):
+        return ('<DDA contact %s %d-%d (%s) %s, N=%.4g N>'
+                % (self.kind, self.id1, self.id2, self.type, self.state, self.normalForce))
+
+
+def contacts(state=None):
+    """The DDA sub-contacts of the last step as a list of ContactView.
+
+    ``state`` ('open', 'sliding', 'locked' or 'closed' for the last two)
+    filters the list. Example::
+
+        for c in contacts('closed'):
+            print(c.id1, c.id2, c.type, c.normalForce)
+    """
+    scene = _require()
+    if state not in (None, 'open', 'sliding', 'locked', 'closed'):
+        raise ValueError("state must be None, 'open', 'sliding', 'locked' or 'closed', got %r" % (state,))
+    bodyOf = scene.bodyOfBlock
+    out = []
+    for i, j, kind, ctype, cstate, normal, point, fn, fs, gap in scene.core.contacts():
+        if state is not None and cstate != state and not (state == 'closed' and cstate != 'open'):
+            continue
+        out.append(ContactView(bodyOf[i], bodyOf[j], kind, ctype, cstate, normal, point, fn, fs, gap))
+    return out
 
 
 def block(body):

@@ -13,6 +13,8 @@ void validateMaterial(const Material& material) {
 		message << "Young's modulus must be positive and finite, got " << material.young << " Pa";
 	else if (!(std::isfinite(material.poisson) && material.poisson > -1 && material.poisson < 0.5))
 		message << "Poisson's ratio must lie in (-1, 0.5), got " << material.poisson;
+	else if (!(std::isfinite(material.frictionAngle) && material.frictionAngle >= 0 && material.frictionAngle < M_PI / 2))
+		message << "friction angle must lie in [0, pi/2) rad, got " << material.frictionAngle << " rad";
 	else
 		return;
 	throw InputError(message.str());

@@ -13,11 +13,14 @@
 
 namespace dda {
 
-// Isotropic linear elastic block material.
+// Isotropic linear elastic block material, and the joint properties its
+// contacts take (a contact uses the smaller friction angle of its two blocks,
+// as YADE's frictional laws do).
 struct Material {
-	double density = 2600;  // kg/m^3, > 0
-	double young = 1e9;     // Pa, > 0
-	double poisson = 0.25;  // -, in (-1, 0.5)
+	double density = 2600;     // kg/m^3, > 0
+	double young = 1e9;        // Pa, > 0
+	double poisson = 0.25;     // -, in (-1, 0.5)
+	double frictionAngle = 0;  // rad, in [0, pi/2); 0 = frictionless joints
 };
 
 // Throws InputError naming the offending value.

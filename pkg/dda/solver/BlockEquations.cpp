@@ -41,13 +41,20 @@ double largestVertexDisplacement(const Block& block, const Vector12& D) {
 	return std::sqrt(largest);
 }
 
+BlockMotion blockMotion(const Block& block, const Vector12& D) {
+	BlockMotion motion;
+	motion.rotation = rotationFromVector(D.segment<3>(3));
+	motion.deformation = (Matrix3::Identity() + strainTensor(D.segment<6>(6))) * motion.rotation;
+	motion.oldCentroid = block.centroid;
+	motion.newCentroid = block.centroid + D.head<3>();
+	return motion;
+}
+
 void applyStep(Block& block, const Vector12& D, const Vector12& v0, double dt) {
-	const Matrix3 rotation = rotationFromVector(D.segment<3>(3));
-	const Matrix3 strain = strainTensor(D.segment<6>(6));
-	const Matrix3 deformation = (Matrix3::Identity() + strain) * rotation;
-	const Vector3 oldCentroid = block.centroid;
-	const Vector3 newCentroid = oldCentroid + D.head<3>();
-	auto move = [&](const Vector3& x) -> Vector3 { return newCentroid + deformation * (x - oldCentroid); };
+	const BlockMotion move = blockMotion(block, D);
+	const Matrix3& rotation = move.rotation;
+	const Matrix3& deformation = move.deformation;
+	const Vector3 newCentroid = move.newCentroid;
 
 	for (Vector3& x : block.vertices) x = move(x);
 	for (FixedPoint& point : block.fixedPoints) point.position = move(point.position);

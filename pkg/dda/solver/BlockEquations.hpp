@@ -40,6 +40,17 @@ Vector12 solveBlock(const Block& block, const BlockSystem& system);
 // Largest displacement of a vertex for the unknowns D [m].
 double largestVertexDisplacement(const Block& block, const Vector12& D);
 
+// The map of one block's points over a step: x -> c' + (I + S) R (x - c), an
+// exact rotation about the centroid c followed by the strain S, then the
+// translation (c' = c + t). Vertices, supports, loads and contact anchors all
+// move by it.
+struct BlockMotion {
+	Vector3 oldCentroid, newCentroid;
+	Matrix3 rotation, deformation;  // R and (I + S) R
+	Vector3 operator()(const Vector3& x) const { return newCentroid + deformation * (x - oldCentroid); }
+};
+BlockMotion blockMotion(const Block& block, const Vector12& D);
+
 // Applies an accepted step: exact rotation about the centroid, then the strain,
 // to vertices, supports, loads and mass properties; new velocity; stress update
 // (the old stress rotated with the block plus E times the strain increment).

@@ -33,6 +33,32 @@ struct IntegratorSettings {
 	// Stiffness of a fixed point's penalty spring when the block's own is not
 	// given: factor x Young's modulus x block size (cube root of volume) [N/m].
 	double fixedPointPenaltyFactor = 1000;
+
+	// ---- contacts (Shi's rules, scaled to the block and the step)
+	// Contact distance d0 [m]: pairs of features closer than this become
+	// (possibly open) contacts. <= 0: contactDistanceFactor x the allowed step
+	// displacement (Shi's d0 = 2.5 x g2 x w0), so no contact can be crossed
+	// within one step unseen.
+	double contactDistance = 0;
+	double contactDistanceFactor = 2.5;  // [-], > 1
+	// Normal penalty stiffness of a sub-contact [N/m]: contactPenaltyFactor x
+	// min(E size) of its two blocks (size = cube root of the volume), so the
+	// penetration under a block's own weight scales like rho g size^2 / (factor E)
+	// whatever the scene's units. Shi recommends 40 to 100 x E (2D).
+	double contactPenaltyFactor = 40;
+	// Shear spring of a locked contact: shearStiffnessRatio x normal stiffness
+	// [-]; 0.4 = G/E of a rock with Poisson's ratio 0.25.
+	double shearStiffnessRatio = 0.4;
+	// Open-close iteration: at most this many solves per step; a step whose
+	// contact states still change is redone with dt x openCloseShrink (Shi: 6
+	// and 0.3). Counted in StepStatistics.
+	int maxOpenCloseIterations = 6;
+	double openCloseShrink = 0.3;
+	// A closed contact opens when its linearised gap exceeds
+	// openCloseTolerance x allowed step displacement [-] (a band against
+	// chatter; the tension it lets through is kn times that gap).
+	double openCloseTolerance = 1e-9;
+
 	// Worker threads for per-block work; 0 = OpenMP's default. Results do not
 	// depend on the count.
 	int threads = 0;
@@ -48,7 +74,24 @@ struct StepStatistics {
 	int blocks = 0;                  // all blocks
 	int movingBlocks = 0;            // blocks with unknowns
 	int unknowns = 0;                // size of the system solved
+	// contacts
+	double contactDistance = 0;      // d0 used [m]
+	long candidatePairs = 0;         // block pairs from the broad phase
+	int contactPairs = 0;            // block pairs within d0
+	int contacts = 0;                // vertex-face and edge-edge sub-contacts
+	int closedContacts = 0;          // sliding or locked at the end of the step
+	int slidingContacts = 0;
+	int openCloseIterations = 0;     // solves in the accepted attempt
+	int openCloseIterationsTotal = 0;  // solves in all attempts of the step
+	int stateChanges = 0;            // contact state changes in the accepted attempt
+	int openCloseCuts = 0;           // dt cuts because the iteration did not converge
+	long openCloseFailures = 0;      // steps accepted unconverged after maxStepCuts (cumulative)
+	double maxPenetration = 0;       // deepest closed contact at the end of the step [m]
+	int components = 0;              // independent systems solved (moving blocks coupled by contacts)
+	int largestComponent = 0;        // blocks in the largest one
 	// wall time per phase [s]
+	double timeBroadPhase = 0;
+	double timeNarrowPhase = 0;
 	double timeAssembly = 0;
 	double timeSolve = 0;
 	double timeUpdate = 0;

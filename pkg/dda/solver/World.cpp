@@ -1,5 +1,6 @@
 #include "World.hpp"
 
+#include "ContactEquations.hpp"
 #include "dda/geometry/MassProperties.hpp"
 
 #include <omp.h>
@@ -16,6 +17,11 @@ using Clock = std::chrono::steady_clock;
 // Per-block loops run in parallel only from this many blocks on: waking an
 // OpenMP team costs tens of microseconds, more than a few blocks' work.
 constexpr int kMinBlocksForThreads = 64;
+// A pair keeps its entrance feature while that feature's separation stays
+// within this fraction of the contact distance of the best axis (Shi's rule
+// that a contact keeps its entrance face; stops the normal flipping between
+// nearly equal faces from step to step).
+constexpr double kEntranceHysteresis = 0.1;
 double secondsSince(Clock::time_point start) {
 	return std::chrono::duration<double>(Clock::now() - start).count();
 }
@@ -115,9 +121,104 @@ void World::validateSettings(const IntegratorSettings& s) const {
 		message << "maxStepCuts must be >= 0, got " << s.maxStepCuts;
 	else if (!(s.fixedPointPenaltyFactor > 0 && std::isfinite(s.fixedPointPenaltyFactor)))
 		message << "fixedPointPenaltyFactor must be positive, got " << s.fixedPointPenaltyFactor;
+	else if (!(std::isfinite(s.contactDistance) && s.contactDistance >= 0))
+		message << "contactDistance must be >= 0 and finite, got " << s.contactDistance << " m";
+	else if (!(std::isfinite(s.contactDistanceFactor) && s.contactDistanceFactor >= 1))
+		message << "contactDistanceFactor must be >= 1, got " << s.contactDistanceFactor;
+	else if (!(std::isfinite(s.contactPenaltyFactor) && s.contactPenaltyFactor > 0))
+		message << "contactPenaltyFactor must be positive, got " << s.contactPenaltyFactor;
+	else if (!(std::isfinite(s.shearStiffnessRatio) && s.shearStiffnessRatio >= 0))
+		message << "shearStiffnessRatio must be >= 0, got " << s.shearStiffnessRatio;
+	else if (s.maxOpenCloseIterations < 1)
+		message << "maxOpenCloseIterations must be >= 1, got " << s.maxOpenCloseIterations;
+	else if (!(s.openCloseShrink > 0 && s.openCloseShrink < 1))
+		message << "openCloseShrink must lie in (0, 1), got " << s.openCloseShrink;
+	else if (!(std::isfinite(s.openCloseTolerance) && s.openCloseTolerance >= 0))
+		message << "openCloseTolerance must be >= 0, got " << s.openCloseTolerance;
 	else
 		return;
 	throw InputError(message.str());
+}
+
+void World::setCollider(std::unique_ptr<Collider> collider) {
+	if (!collider) throw InputError("a collider is required");
+	collider_ = std::move(collider);
+}
+
+const Vector12& World::unknowns(int block) const {
+	static const Vector12 zero = Vector12::Zero();
+	const int k = movingIndex_[block];
+	return k < 0 ? zero : solutions_[k];
+}
+
+void World::detectContacts(const IntegratorSettings& settings, StepStatistics& stats) {
+	auto phase = Clock::now();
+	store_.beginStep();
+	BroadPhaseStatistics broad;
+	collider_->findPairs(blocks_, stats.contactDistance, pairs_, broad);
+	stats.candidatePairs = broad.candidatePairs;
+	stats.timeBroadPhase = secondsSince(phase);
+
+	phase = Clock::now();
+	const int pairCount = static_cast<int>(pairs_.size());
+	pairResults_.assign(pairCount, std::nullopt);
+	std::vector<double> diagonal(blocks_.size());
+	for (std::size_t b = 0; b < blocks_.size(); ++b) {
+		Eigen::AlignedBox3d box;
+		for (const Vector3& x : blocks_[b].vertices) box.extend(x);
+		diagonal[b] = box.diagonal().norm();
+	}
+#pragma omp parallel for schedule(dynamic, 16) if (pairCount >= kMinBlocksForThreads)
+	for (int p = 0; p < pairCount; ++p) {
+		const auto [a, b] = pairs_[p];
+		const Block& A = blocks_[a];
+		const Block& B = blocks_[b];
+		DetectionSettings detection;
+		detection.contactDistance = stats.contactDistance;
+		detection.lengthTolerance = kDefaultRelativeLengthTolerance * std::max(diagonal[a], diagonal[b]);
+		detection.hysteresis = std::max(kEntranceHysteresis * stats.contactDistance, detection.lengthTolerance);
+		pairResults_[p] = detectPairContacts(BlockGeometry{A.shape.get(), &A.vertices, A.centroid},
+		                                     BlockGeometry{B.shape.get(), &B.vertices, B.centroid}, detection,
+		                                     store_.previousEntrance(a, b));
+	}
+	for (int p = 0; p < pairCount; ++p) {
+		if (!pairResults_[p]) continue;
+		const auto [a, b] = pairs_[p];
+		const PairContacts& pair = *pairResults_[p];
+		++stats.contactPairs;
+		store_.setEntrance(a, b, pair.entrance);
+		for (const SubContact& sub : pair.contacts) {
+			const int i = sub.firstIsA ? a : b, j = sub.firstIsA ? b : a;
+			const ContactKey key{i, j, sub.kind, sub.feature1, sub.feature2};
+			Contact& contact = store_.add(key, pair.type, sub, *blocks_[i].shape, *blocks_[j].shape);
+			prepareContact(contact, blocks_[i], blocks_[j], settings);
+		}
+	}
+	stats.contacts = static_cast<int>(store_.contacts().size());
+	stats.timeNarrowPhase = secondsSince(phase);
+}
+
+void World::assembleContacts() {
+	Matrix24 stiffness;
+	Vector24 force;
+	for (const Contact& contact : store_.contacts()) {
+		const int bi = contact.key.blockI, bj = contact.key.blockJ;
+		if (!contactTerms(contact, blocks_[bi], blocks_[bj], stiffness, force)) continue;
+		const int mi = movingIndex_[bi], mj = movingIndex_[bj];
+		if (mi >= 0) {
+			coupled_.diagonal(mi) += stiffness.topLeftCorner<12, 12>();
+			coupled_.force(mi) += force.head<12>();
+		}
+		if (mj >= 0) {
+			coupled_.diagonal(mj) += stiffness.bottomRightCorner<12, 12>();
+			coupled_.force(mj) += force.tail<12>();
+		}
+		if (mi >= 0 && mj >= 0) {
+			bool transposed;
+			Matrix12& offDiagonal = coupled_.offDiagonal(mi, mj, transposed);
+			offDiagonal += transposed ? stiffness.bottomLeftCorner<12, 12>() : stiffness.topRightCorner<12, 12>();
+		}
+	}
 }
 
 double World::step(const IntegratorSettings& settings) {
@@ -128,18 +229,46 @@ double World::step(const IntegratorSettings& settings) {
 	StepStatistics stats;
 	stats.blocks = blockCount();
 	moving_.clear();
-	for (int i = 0; i < blockCount(); ++i)
-		if (!blocks_[i].fixed) moving_.push_back(i);
+	movingIndex_.assign(blockCount(), -1);
+	for (int i = 0; i < blockCount(); ++i) {
+		if (blocks_[i].fixed) continue;
+		movingIndex_[i] = static_cast<int>(moving_.size());
+		moving_.push_back(i);
+	}
 	const int n = static_cast<int>(moving_.size());
 	stats.movingBlocks = n;
 	stats.unknowns = kBlockDofs * n;
 	systems_.resize(n);
 	solutions_.resize(n);
 	startVelocities_.resize(n);
-	for (int k = 0; k < n; ++k) startVelocities_[k] = startVelocity(blocks_[moving_[k]], settings);
+	movingBlocks_.resize(n);
+	for (int k = 0; k < n; ++k) {
+		startVelocities_[k] = startVelocity(blocks_[moving_[k]], settings);
+		movingBlocks_[k] = &blocks_[moving_[k]];
+	}
 
 	stats.allowedDisplacement = settings.maxDisplacement > 0 ? settings.maxDisplacement
 	                                                         : settings.maxDisplacementRatio * sceneHalfSize();
+	stats.contactDistance = settings.contactDistance > 0 ? settings.contactDistance
+	                                                     : settings.contactDistanceFactor * stats.allowedDisplacement;
+	detectContacts(settings, stats);
+	std::vector<Contact>& contacts = store_.contacts();
+
+	// Structure of the global system: which moving blocks contacts join.
+	std::vector<std::pair<int, int>> links;
+	std::vector<char> hasSprings(n, 0);
+	for (int k = 0; k < n; ++k) hasSprings[k] = !blocks_[moving_[k]].fixedPoints.empty();
+	for (const Contact& contact : contacts) {
+		const int mi = movingIndex_[contact.key.blockI], mj = movingIndex_[contact.key.blockJ];
+		if (mi >= 0) hasSprings[mi] = 1;
+		if (mj >= 0) hasSprings[mj] = 1;
+		if (mi >= 0 && mj >= 0) links.emplace_back(mi, mj);
+	}
+	coupled_.build(n, links, hasSprings);
+	stats.components = coupled_.components();
+	stats.largestComponent = coupled_.largestComponent();
+
+	const double openTolerance = settings.openCloseTolerance * stats.allowedDisplacement;
 	double dt = nextTimeStep_ > 0 ? std::min(nextTimeStep_, settings.maxTimeStep) : settings.maxTimeStep;
 
 	for (int attempt = 0;; ++attempt) {
@@ -148,21 +277,54 @@ double World::step(const IntegratorSettings& settings) {
 		for (int k = 0; k < n; ++k) assembleBlock(blocks_[moving_[k]], settings, dt, systems_[k]);
 		stats.timeAssembly += secondsSince(phase);
 
-		phase = Clock::now();
+		// Open-close iteration: solve with the trial contact states, update the
+		// states from the solution, until no state changes.
+		for (Contact& contact : contacts) startTrial(contact);
+		bool converged = false;
+		int iterations = 0, changes = 0;
+		while (iterations < std::max(1, settings.maxOpenCloseIterations)) {
+			phase = Clock::now();
+			coupled_.reset(systems_);
+			assembleContacts();
+			stats.timeAssembly += secondsSince(phase);
+			phase = Clock::now();
+			coupled_.solve(movingBlocks_, solutions_, kMinBlocksForThreads);
+			stats.timeSolve += secondsSince(phase);
+			++iterations;
+			changes = 0;
+			for (Contact& contact : contacts) {
+				const int bi = contact.key.blockI, bj = contact.key.blockJ;
+				changes += updateContactState(contact, blocks_[bi], blocks_[bj], unknowns(bi), unknowns(bj), openTolerance);
+			}
+			if (changes == 0) {
+				converged = true;
+				break;
+			}
+		}
+		stats.openCloseIterations = iterations;
+		stats.openCloseIterationsTotal += iterations;
+		stats.stateChanges = changes;
+
 		double largest = 0;
 #pragma omp parallel for schedule(static) reduction(max : largest) if (n >= kMinBlocksForThreads)
-		for (int k = 0; k < n; ++k) {
-			solutions_[k] = solveBlock(blocks_[moving_[k]], systems_[k]);
-			largest = std::max(largest, largestVertexDisplacement(blocks_[moving_[k]], solutions_[k]));
-		}
-		stats.timeSolve += secondsSince(phase);
-
+		for (int k = 0; k < n; ++k) largest = std::max(largest, largestVertexDisplacement(blocks_[moving_[k]], solutions_[k]));
 		if (!std::isfinite(largest)) {
 			std::ostringstream message;
 			message << "the DDA step produced a non-finite displacement (dt = " << dt << " s)";
 			throw std::runtime_error(message.str());
 		}
 		stats.maxDisplacement = largest;
+
+		if (!converged) {
+			if (attempt == settings.maxStepCuts) {
+				++openCloseFailures_;
+				break;
+			}
+			dt *= settings.openCloseShrink;
+			++stats.openCloseCuts;
+			++stats.stepCuts;
+			continue;
+		}
 		if (largest <= stats.allowedDisplacement || stats.allowedDisplacement <= 0) break;
 		if (attempt == settings.maxStepCuts) {
 			++displacementLimitMisses_;
@@ -175,6 +337,27 @@ double World::step(const IntegratorSettings& settings) {
 	}
 
 	const auto phase = Clock::now();
+	// Contacts first (forces from the accepted solution, anchors carried along
+	// with their blocks), then the blocks themselves.
+	motions_.resize(n);
+	for (int k = 0; k < n; ++k) motions_[k] = blockMotion(blocks_[moving_[k]], solutions_[k]);
+	for (Contact& contact : contacts) {
+		const int bi = contact.key.blockI, bj = contact.key.blockJ;
+		finishContact(contact, blocks_[bi], blocks_[bj], unknowns(bi), unknowns(bj));
+		ContactHistory& trial = contact.trial;
+		contact.point = movingIndex_[bi] >= 0 ? motions_[movingIndex_[bi]](contact.geometry.pointI) : contact.geometry.pointI;
+		if (trial.state == ContactState::Locked) {
+			if (movingIndex_[bi] >= 0) trial.anchorI = motions_[movingIndex_[bi]](trial.anchorI);
+			if (movingIndex_[bj] >= 0) trial.anchorJ = motions_[movingIndex_[bj]](trial.anchorJ);
+		}
+		if (trial.state != ContactState::Open) {
+			++stats.closedContacts;
+			stats.slidingContacts += trial.state == ContactState::Sliding;
+			stats.maxPenetration =
+			    std::max(stats.maxPenetration, -contactGap(contact, unknowns(bi), unknowns(bj)));
+		}
+		contact.history = trial;
+	}
 #pragma omp parallel for schedule(static) if (n >= kMinBlocksForThreads)
 	for (int k = 0; k < n; ++k) applyStep(blocks_[moving_[k]], solutions_[k], startVelocities_[k], dt);
 	stats.timeUpdate = secondsSince(phase);
@@ -184,6 +367,7 @@ double World::step(const IntegratorSettings& settings) {
 	++steps_;
 	stats.dt = dt;
 	stats.displacementLimitMisses = displacementLimitMisses_;
+	stats.openCloseFailures = openCloseFailures_;
 	stats.timeTotal = secondsSince(stepStart);
 	stats_ = stats;
 	return dt;

@@ -3,9 +3,14 @@
 #pragma once
 
 #include "BlockEquations.hpp"
+#include "CoupledSystem.hpp"
 #include "IntegratorSettings.hpp"
 #include "dda/block/Block.hpp"
+#include "dda/collider/Collider.hpp"
+#include "dda/contact/Contact.hpp"
 
+#include <memory>
+#include <utility>
 #include <vector>
 
 namespace dda {
@@ -30,12 +35,31 @@ public:
 	const StepStatistics& lastStep() const { return stats_; }
 	double time() const { return time_; }
 	long steps() const { return steps_; }
+	// Sub-contacts of the last step, with their state at its end.
+	const std::vector<Contact>& contacts() const { return store_.contacts(); }
+	// The broad phase (AllPairsCollider unless set).
+	void setCollider(std::unique_ptr<Collider> collider);
+	const Collider& collider() const { return *collider_; }
 	// Half the largest extent of the bounding box of all blocks [m] (Shi's w0),
 	// measured at the first step after blocks were added.
 	double sceneHalfSize();
 
 private:
 	void validateSettings(const IntegratorSettings& settings) const;
+	// Broad and narrow phase; fills store_ with this step's sub-contacts.
+	void detectContacts(const IntegratorSettings& settings, StepStatistics& stats);
+	// Adds the trial-state terms of every contact to coupled_.
+	void assembleContacts();
+	const Vector12& unknowns(int block) const;
+	std::unique_ptr<Collider> collider_ = std::make_unique<AllPairsCollider>();
+	ContactStore store_;
+	CoupledSystem coupled_;
+	long openCloseFailures_ = 0;
+	std::vector<std::pair<int, int>> pairs_;
+	std::vector<std::optional<PairContacts>> pairResults_;
+	std::vector<int> movingIndex_;  // block -> index in moving_, -1 for fixed blocks
+	std::vector<const Block*> movingBlocks_;
+	std::vector<BlockMotion> motions_;
 	std::vector<Block> blocks_;
 	StepStatistics stats_;
 	double nextTimeStep_ = 0;  // dt to try first in the next step; 0 = maxTimeStep

@@ -1,0 +1,104 @@
+// A DDA sub-contact between two blocks and the history it carries from step
+// to step (open/sliding/locked state, shear-spring anchors, sliding direction).
+//
+// Identity. A sub-contact is known by its blocks and features: (block i,
+// block j, kind, feature of i, feature of j), where i owns the vertex
+// (vertex-face) or the first edge (edge-edge) and j owns the entrance face or
+// the second edge. The next step's sub-contact with the same identity takes
+// over its history. When a vertex slides from a face onto a neighbouring face
+// of the same block (or an edge-edge contact moves to an edge sharing a corner
+// with the old one) the identity changes; ContactStore::inherit then looks for
+// that neighbour, so a sliding contact keeps sliding and a locked contact
+// keeps its shear spring.
+#pragma once
+
+#include "PairDetection.hpp"
+
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+namespace dda {
+
+enum class ContactState : std::uint8_t { Open, Sliding, Locked };
+const char* contactStateName(ContactState state);  // "open", "sliding", "locked"
+
+struct ContactKey {
+	int blockI = -1, blockJ = -1;
+	ContactKind kind = ContactKind::VertexFace;
+	int feature1 = -1, feature2 = -1;
+	bool operator==(const ContactKey& o) const {
+		return blockI == o.blockI && blockJ == o.blockJ && kind == o.kind && feature1 == o.feature1 &&
+		       feature2 == o.feature2;
+	}
+};
+struct ContactKeyHash {
+	std::size_t operator()(const ContactKey& k) const {
+		std::uint64_t h = static_cast<std::uint64_t>(k.blockI) * 0x9E3779B97F4A7C15ull;
+		h ^= static_cast<std::uint64_t>(k.blockJ) + 0x7F4A7C159E3779B9ull + (h << 6) + (h >> 2);
+		h ^= static_cast<std::uint64_t>(k.feature1) * 31 + static_cast<std::uint64_t>(k.feature2) * 1031 +
+		     static_cast<std::uint64_t>(k.kind) + (h << 6) + (h >> 2);
+		return static_cast<std::size_t>(h);
+	}
+};
+
+// What a sub-contact carries into the next step.
+struct ContactHistory {
+	ContactState state = ContactState::Open;
+	// Locked: the shear spring joins these two material points, one of block
+	// i and one of block j [m], moved with their blocks every step.
+	Vector3 anchorI = Vector3::Zero(), anchorJ = Vector3::Zero();
+	// Sliding: unit direction of block i's motion relative to block j, along
+	// which friction resists.
+	Vector3 slidingDirection = Vector3::Zero();
+	double normalForce = 0;  // [N], >= 0, compressive; feeds the next friction force
+	Vector3 shearForce = Vector3::Zero();  // force on block i in the tangent plane [N]
+};
+
+struct Contact {
+	ContactKey key;
+	ContactType pairType = ContactType::VertexFace;  // structural type of its pair
+	SubContact geometry;      // at the start of the step
+	ContactHistory history;   // state at the end of the last accepted step
+	ContactHistory trial;     // state during this step's open-close iteration
+	// Mechanics at the start of the step (ContactEquations.hpp).
+	LinearizedDistance normal;   // gap d0 and its gradients e_i, e_j
+	double normalStiffness = 0;  // [N/m]
+	double shearStiffness = 0;   // [N/m]
+	double frictionTangent = 0;  // tan(friction angle) [-]
+	bool isNew = true;           // no history was found
+	// Block i's contact point at the end of the step [m] (for reports).
+	Vector3 point = Vector3::Zero();
+};
+
+// The contacts of the current step and their predecessors.
+class ContactStore {
+public:
+	// Moves the current contacts into the history pool, ready for the next
+	// detection (call once per step before adding the new contacts).
+	void beginStep();
+	// Adds a detected sub-contact, taking over the history of its predecessor
+	// (same identity, else a neighbour as described above). `shapeI`/`shapeJ`
+	// give the topology for the neighbour search.
+	Contact& add(const ContactKey& key, ContactType pairType, const SubContact& geometry,
+	             const ConvexPolyhedron& shapeI, const ConvexPolyhedron& shapeJ);
+	std::vector<Contact>& contacts() { return current_; }
+	const std::vector<Contact>& contacts() const { return current_; }
+
+	// Entrance features of block pairs (a < b) from the last detection.
+	const EntranceFeature& previousEntrance(int a, int b) const;
+	void setEntrance(int a, int b, const EntranceFeature& entrance);
+
+	void clear();
+
+private:
+	std::vector<Contact> current_;
+	std::vector<Contact> previous_;
+	std::unordered_map<ContactKey, int, ContactKeyHash> previousIndex_;
+	// previous contacts by (blocks, kind, feature of i), feature2 = -1
+	std::unordered_map<ContactKey, std::vector<int>, ContactKeyHash> byFeature1_;
+	std::unordered_map<std::uint64_t, EntranceFeature> entrances_, previousEntrances_;
+	std::vector<char> claimed_;  // previous contacts already inherited this step
+};
+
+}  // namespace dda

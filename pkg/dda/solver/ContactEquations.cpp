@@ -1,0 +1,164 @@
+#include "ContactEquations.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace dda {
+
+namespace {
+
+Matrix3 tangentProjector(const Vector3& normal) { return Matrix3::Identity() - normal * normal.transpose(); }
+
+// [T_i(x_i), -T_j(x_j)]: the relative displacement of two material points per unit of the 24 unknowns.
+Eigen::Matrix<double, 3, 24> relativeDisplacementMatrix(const Block& blockI, const Vector3& xi, const Block& blockJ,
+                                                        const Vector3& xj) {
+	Eigen::Matrix<double, 3, 24> G;
+	G.leftCols<12>() = displacementMatrix(xi - blockI.centroid);
+	G.rightCols<12>() = -displacementMatrix(xj - blockJ.centroid);
+	return G;
+}
+
+Vector24 stacked(const Vector12& a, const Vector12& b) {
+	Vector24 v;
+	v << a, b;
+	return v;
+}
+
+bool closed(ContactState state) { return state != ContactState::Open; }
+
+// State a contact takes when it closes: locked, unless there is no friction to lock it.
+void close(Contact& contact) {
+	ContactHistory& trial = contact.trial;
+	trial.state = contact.frictionTangent > 0 ? ContactState::Locked : ContactState::Sliding;
+	trial.anchorI = contact.geometry.pointI;
+	trial.anchorJ = contact.geometry.pointJ;
+	trial.slidingDirection.setZero();
+}
+
+}  // namespace
+
+void prepareContact(Contact& contact, const Block& blockI, const Block& blockJ, const IntegratorSettings& settings) {
+	const double stiffnessI = blockI.material.young * blockI.size;
+	const double stiffnessJ = blockJ.material.young * blockJ.size;
+	contact.normalStiffness = settings.contactPenaltyFactor * std::min(stiffnessI, stiffnessJ);
+	contact.shearStiffness = settings.shearStiffnessRatio * contact.normalStiffness;
+	contact.frictionTangent = std::tan(std::min(blockI.material.frictionAngle, blockJ.material.frictionAngle));
+	contact.normal = linearizeNormalDistance(contact.geometry.stencil, blockI.centroid, blockJ.centroid);
+}
+
+void startTrial(Contact& contact) {
+	if (!contact.isNew) {
+		contact.trial = contact.history;
+	} else {
+		contact.trial = ContactHistory();
+		if (contact.normal.valid && contact.normal.d0 <= 0) {
+			close(contact);
+			contact.trial.normalForce = -contact.normalStiffness * contact.normal.d0;
+		}
+	}
+	if (!contact.normal.valid) contact.trial.state = ContactState::Open;
+}
+
+double contactGap(const Contact& contact, const Vector12& Di, const Vector12& Dj) {
+	return contact.normal.d0 + contact.normal.ei.dot(Di) + contact.normal.ej.dot(Dj);
+}
+
+bool contactTerms(const Contact& contact, const Block& blockI, const Block& blockJ, Matrix24& stiffness,
+                  Vector24& force) {
+	const ContactHistory& trial = contact.trial;
+	if (!closed(trial.state)) return false;
+	const Vector24 e = stacked(contact.normal.ei, contact.normal.ej);
+	const double kn = contact.normalStiffness;
+	stiffness.noalias() = kn * e * e.transpose();
+	force.noalias() = -kn * contact.normal.d0 * e;
+
+	const Vector3& n = contact.geometry.normal;
+	if (trial.state == ContactState::Locked) {
+		const Eigen::Matrix<double, 3, 24> G = relativeDisplacementMatrix(blockI, trial.anchorI, blockJ, trial.anchorJ);
+		const Matrix3 P = tangentProjector(n);
+		const double ks = contact.shearStiffness;
+		stiffness.noalias() += ks * G.transpose() * P * G;
+		force.noalias() -= ks * G.transpose() * (P * (trial.anchorI - trial.anchorJ));
+	} else if (contact.frictionTangent > 0 && trial.normalForce > 0) {
+		const Eigen::Matrix<double, 3, 24> H =
+		    relativeDisplacementMatrix(blockI, contact.geometry.pointI, blockJ, contact.geometry.pointJ);
+		force.noalias() -= H.transpose() * (contact.frictionTangent * trial.normalForce * trial.slidingDirection);
+	}
+	return true;
+}
+
+bool updateContactState(Contact& contact, const Block& blockI, const Block& blockJ, const Vector12& Di,
+                        const Vector12& Dj, double openTolerance) {
+	ContactHistory& trial = contact.trial;
+	const ContactState before = trial.state;
+	if (!contact.normal.valid) {
+		trial.state = ContactState::Open;
+		return before != trial.state;
+	}
+	const double gap = contactGap(contact, Di, Dj);
+	const Vector3& n = contact.geometry.normal;
+
+	if (!closed(before)) {
+		if (gap < 0) close(contact);
+	} else if (gap > openTolerance) {
+		trial.state = ContactState::Open;
+	}
+	if (!closed(trial.state)) {
+		trial.normalForce = 0;
+		return before != trial.state;
+	}
+	trial.normalForce = contact.normalStiffness * std::max(0.0, -gap);
+	if (contact.frictionTangent <= 0) {
+		trial.state = ContactState::Sliding;
+		return before != trial.state;
+	}
+
+	// A closed contact without normal force (its gap inside the opening band)
+	// has no friction capacity to compare with: it keeps its state rather than
+	// flip on round-off of a vanishing shear.
+	if (trial.normalForce <= 0) return before != trial.state;
+	const Matrix3 P = tangentProjector(n);
+	if (trial.state == ContactState::Locked) {
+		const Vector3 delta = (trial.anchorI + displacementAt(trial.anchorI - blockI.centroid, Di)) -
+		                      (trial.anchorJ + displacementAt(trial.anchorJ - blockJ.centroid, Dj));
+		const Vector3 shear = P * delta;
+		const double shearNorm = shear.norm();
+		if (contact.shearStiffness * shearNorm > contact.frictionTangent * trial.normalForce && shearNorm > 0) {
+			trial.state = ContactState::Sliding;
+			trial.slidingDirection = shear / shearNorm;
+		}
+	} else {
+		const Vector3 motion = displacementAt(contact.geometry.pointI - blockI.centroid, Di) -
+		                       displacementAt(contact.geometry.pointJ - blockJ.centroid, Dj);
+		const Vector3 tangential = P * motion;
+		if (tangential.dot(trial.slidingDirection) > 0) {
+			trial.slidingDirection = tangential.normalized();
+		} else {
+			trial.state = ContactState::Locked;
+			trial.anchorI = contact.geometry.pointI;
+			trial.anchorJ = contact.geometry.pointJ;
+		}
+	}
+	return before != trial.state;
+}
+
+void finishContact(Contact& contact, const Block& blockI, const Block& blockJ, const Vector12& Di, const Vector12& Dj) {
+	ContactHistory& trial = contact.trial;
+	trial.shearForce.setZero();
+	if (!closed(trial.state) || !contact.normal.valid) {
+		trial.normalForce = 0;
+		return;
+	}
+	const double gap = contactGap(contact, Di, Dj);
+	trial.normalForce = contact.normalStiffness * std::max(0.0, -gap);
+	const Matrix3 P = tangentProjector(contact.geometry.normal);
+	if (trial.state == ContactState::Locked) {
+		const Vector3 delta = (trial.anchorI + displacementAt(trial.anchorI - blockI.centroid, Di)) -
+		                      (trial.anchorJ + displacementAt(trial.anchorJ - blockJ.centroid, Dj));
+		trial.shearForce = -contact.shearStiffness * (P * delta);
+	} else {
+		trial.shearForce = -contact.frictionTangent * trial.normalForce * trial.slidingDirection;
+	}
+}
+
+}  // namespace dda
