@@ -161,6 +161,16 @@ py::list syncData(SceneLink& s, bool all) {
 	return out;
 }
 
+void setCollider(SceneLink& s, const std::string& name) {
+	if (name == "DESS")
+		s.world.setCollider(std::make_unique<DESSCollider>());
+	else if (name == "AllPairs")
+		s.world.setCollider(std::make_unique<AllPairsCollider>());
+	else
+		throw InputError("unknown collider '" + name + "' (known: DESS, AllPairs)");
+}
+std::string colliderName(const SceneLink& s) { return s.world.collider().name(); }
+
 py::dict lastStep(const SceneLink& s) {
 	const StepStatistics& st = s.world.lastStep();
 	py::dict d;
@@ -237,6 +247,8 @@ BOOST_PYTHON_MODULE(_core) {
 	         (py::arg("points"), py::arg("density"), py::arg("young"), py::arg("poisson"), py::arg("frictionAngle"),
 	          py::arg("fixed")))
 	    .def("contacts", &contactList)
+	    .def("setCollider", &setCollider)
+	    .def("collider", &colliderName)
 	    .def("linkBody", &linkBody)
 	    .def("blockOfBody", &bodyToBlock)
 	    .def("blockCount", &SceneLink::blockCount)

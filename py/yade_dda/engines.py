@@ -48,6 +48,15 @@ class _Parameter:
         engine._updateCommand()
 
 
+_COLLIDERS = ('DESS', 'AllPairs')
+
+
+def _colliderName(value):
+    if value not in _COLLIDERS:
+        raise ValueError('collider must be one of %s, got %r' % (', '.join(_COLLIDERS), value))
+    return value
+
+
 def _vector3(name):
     return lambda value: _vector(value, name)
 
@@ -97,6 +106,9 @@ class DDAIntegrator(wrapper.PyRunner):
       converge (0.3).
     - ``openCloseTolerance`` [-]: a closed contact opens when its gap exceeds
       this x the allowed step displacement (1e-9).
+    - ``collider``: the broad phase, ``'DESS'`` (one sorted box per block,
+      default) or ``'AllPairs'`` (every pair: the reference, O(n^2)). Both
+      give the same contacts; only the time differs.
     - ``syncPeriod``: write the DDA state into YADE's bodies every n steps; 0
       (default) = when something may read it: the last step of ``O.run(n)``,
       ``O.step()``, a step after which another periodic engine (a PyRunner
@@ -131,13 +143,15 @@ class DDAIntegrator(wrapper.PyRunner):
                                         'open-close iterations before dt is cut')
     openCloseShrink = _Parameter(0.3, lambda v: _finite('openCloseShrink', v, 0, 0.99, lowOpen=True),
                                  'dt factor when the open-close iteration does not converge [-]')
+    collider = _Parameter('DESS', lambda v: _colliderName(v),
+                          "broad phase: 'DESS' (sorted boxes, default) or 'AllPairs' (every pair, the oracle)")
     openCloseTolerance = _Parameter(1e-9, lambda v: _finite('openCloseTolerance', v, 0),
                                     'opening gap of a closed contact / allowed step displacement [-]')
 
     _names = ('dt', 'gravity', 'velocityRatio', 'maxDisplacement', 'maxDisplacementRatio', 'timeStepGrowth',
               'maxStepCuts', 'fixedPointPenaltyFactor', 'threads', 'syncPeriod', 'contactDistance',
               'contactPenaltyFactor', 'shearStiffnessRatio', 'maxOpenCloseIterations', 'openCloseShrink',
-              'openCloseTolerance')
+              'openCloseTolerance', 'collider')
 
     def __init__(self, label='', **params):
         wrapper.PyRunner.__init__(self)
@@ -261,6 +275,8 @@ def integratorStep(text):
     if len(scene.bodyOfBlock) != before or scene.checkedEngines != signature:
         _checkEngines(scene, engines)
         scene.checkedEngines = signature
+    if scene.core.collider() != params['collider']:
+        scene.core.setCollider(params['collider'])
     O.dt = scene.core.step(settings)
     if _syncNeeded(params, engines):
         scene.sync()

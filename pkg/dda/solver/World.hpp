@@ -37,7 +37,7 @@ public:
 	long steps() const { return steps_; }
 	// Sub-contacts of the last step, with their state at its end.
 	const std::vector<Contact>& contacts() const { return store_.contacts(); }
-	// The broad phase (AllPairsCollider unless set).
+	// The broad phase (DESSCollider unless set).
 	void setCollider(std::unique_ptr<Collider> collider);
 	const Collider& collider() const { return *collider_; }
 	// Half the largest extent of the bounding box of all blocks [m] (Shi's w0),
@@ -51,7 +51,7 @@ private:
 	// Adds the trial-state terms of every contact to coupled_.
 	void assembleContacts();
 	const Vector12& unknowns(int block) const;
-	std::unique_ptr<Collider> collider_ = std::make_unique<AllPairsCollider>();
+	std::unique_ptr<Collider> collider_ = std::make_unique<DESSCollider>();
 	ContactStore store_;
 	CoupledSystem coupled_;
 	long openCloseFailures_ = 0;
