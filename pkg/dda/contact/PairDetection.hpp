@@ -1,0 +1,159 @@
+// Narrow phase of one pair of convex blocks: is the pair within the contact
+// distance, what is its structural contact type (Wu et al. 2014, Table 1), and
+// which vertex-face and edge-edge sub-contacts represent it.
+//
+// Method: separating axes, then the entrance feature.
+//   0. Early out: the corners' bounding boxes, widened by d0, do not overlap.
+//   1. Separation along every candidate axis: the outward normal of each face
+//      of either block (separation = smallest signed distance of the other
+//      block's corners from the plane of the face's chooseFaceCorners
+//      triangle, the plane every vertex-face gap uses) and the cross product
+//      of each non-parallel edge pair whose arcs cross on the Gauss map (a
+//      face of the Minkowski difference; n oriented out of A at its edge,
+//      separation = n . (point on B's edge - point on A's edge)). For convex
+//      blocks the largest separation is minus the least penetration depth
+//      when they overlap, and a lower bound of their distance when apart
+//      (equal to it unless the closest features are two corners or a corner
+//      and an edge). A pair with an axis farther than d0, or with bounding
+//      boxes farther than d0 apart, has no contact: both imply a distance
+//      above d0, so a pair within d0 is never missed.
+//   2. The axis of largest separation is the entrance feature: the face the
+//      other block's corners enter, or the crossing edges. In order:
+//        - the previous step's entrance feature while its separation stays
+//          within max(hysteresis, lengthTolerance) of the best axis (Shi's
+//          rule that a contact keeps its entrance face);
+//        - an edge axis only when it beats the best face by more than
+//          lengthTolerance (faces win ties);
+//        - among faces within lengthTolerance of the best: the larger area
+//          (equal to a relative 1e-9), then A before B, then the lower face
+//          index (deterministic).
+//   3. Sub-contacts. "Within d0" below means within d0 + lengthTolerance (a
+//      face is planar only to within its tolerance, so a corner touching it
+//      may lie that far off its triangle's plane). A face entrance F of block
+//      R, normal n, entered by the other block I gives
+//        - vertex-face F <- P for each corner P of I within d0 of F's plane
+//          whose projection lies in F widened by d0 (a corner just past F's
+//          edge or corner is a vertex-edge or vertex-vertex contact, entered
+//          through F);
+//        - vertex-face G <- Q for each corner Q of F within d0 of I, G the
+//          face of I of largest signed distance of Q (Q's own entrance face),
+//          Q's projection in G widened by d0, and Q not within lengthTolerance
+//          of a corner P already used (coincident corners give one contact);
+//        - edge-edge for each edge of I crossing an edge of F with both
+//          closest points more than lengthTolerance inside the segments (a
+//          crossing at an endpoint is a vertex contact), non-parallel, its
+//          gap within d0, its point on I's edge within d0 of F's plane, its
+//          normal within 60 degrees of n and its gap no deeper than
+//          2 x (the entrance's penetration) + d0: an edge piercing F steeply
+//          near F's boundary has its line distance in F's plane and would
+//          push sideways by an unrelated depth.
+//      An edge entrance gives one edge-edge sub-contact (block i = A), or
+//      falls back to the best face when the two edges do not cross strictly
+//      inside. Edge-edge stencils take as reference direction (from block i
+//      towards block j) the sum of the outward normals of the faces at i's
+//      edge minus that at j's edge.
+//   4. Structural type from the contact features: on each block, the points
+//      of its sub-contacts (pointI or pointJ) lie within d0 + lengthTolerance
+//      of one corner (vertex), else of one edge (edge), else span a face.
+//      Without sub-contacts, the corners of each block within that tolerance
+//      of its extreme along the entrance normal are used instead. The
+//      entrance normal alone would not do: in an exact corner-on-corner
+//      placement it is a face normal, whose support is a whole face.
+//      Two edges are parallel when their cross product is exactly zero
+//      (CGAL exact predicate) or within the angle tolerance.
+// Signs that decide topology (which side of a face plane a corner is on when
+// its double distance is below round-off; whether two edges meet exactly;
+// whether Gauss-map arcs cross) use CGAL's exact predicates; distances are
+// doubles. Exact placements (corner on corner, on an edge, on a face; edges
+// crossing or collinear; coplanar faces) are touching with d0 = 0.
+//
+// Geometry only: blocks are given as vertex arrays plus topology. Units: m.
+#pragma once
+
+#include "Distance.hpp"
+#include "Linearization.hpp"
+#include "dda/geometry/ConvexPolyhedron.hpp"
+
+#include <optional>
+#include <vector>
+
+namespace dda {
+
+// The seven structural contact types of Table 1.
+enum class ContactType {
+	VertexVertex,
+	VertexEdge,
+	VertexFace,
+	EdgeEdgeCrossing,
+	EdgeEdgeParallel,
+	EdgeFace,
+	FaceFace,
+};
+const char* contactTypeName(ContactType type);  // "VV", "VE", "VF", "EE", "EEp", "EF", "FF"
+
+// A block as the narrow phase sees it: current corners [m] and topology.
+struct BlockGeometry {
+	const ConvexPolyhedron* shape = nullptr;       // faces, edges, edgeFaces
+	const std::vector<Vector3>* vertices = nullptr;  // current corners [m]
+	Vector3 centroid = Vector3::Zero();            // [m]
+};
+
+// Which feature is the pair's entrance feature (step 2).
+struct EntranceFeature {
+	enum Kind { None, FaceOfA, FaceOfB, EdgePair } kind = None;
+	int feature = -1;  // face index (FaceOfA/FaceOfB) or edge of A (EdgePair)
+	int other = -1;    // edge of B (EdgePair)
+	bool operator==(const EntranceFeature& o) const {
+		return kind == o.kind && feature == o.feature && other == o.other;
+	}
+};
+
+struct DetectionSettings {
+	double contactDistance = 0;  // d0 [m], >= 0
+	double lengthTolerance = 0;  // [m], > 0: coincident corners, on-segment, inside-face tests
+	double angleTolerance = kDefaultParallelAngleTolerance;  // [rad], parallel edges
+	// The previous entrance feature is kept while its separation is within
+	// this of the best axis [m] (rule: 0.1 x d0; lengthTolerance is used when
+	// smaller).
+	double hysteresis = 0;
+};
+
+// One vertex-face or edge-edge sub-contact. Blocks are called A and B (the
+// pair's order); `first` is the block owning the vertex (vertex-face) or edge 1
+// (edge-edge), i.e. block i of the stencil, the other is block j.
+struct SubContact {
+	ContactKind kind = ContactKind::VertexFace;
+	bool firstIsA = true;  // block i of the stencil is A (else B)
+	// vertex-face: feature1 = vertex of block i, feature2 = face of block j;
+	// edge-edge:   feature1 = edge of block i,   feature2 = edge of block j.
+	int feature1 = -1, feature2 = -1;
+	// Start-of-step stencil (vertex-face: the face's chooseFaceCorners triangle,
+	// so the gap below is exactly linearizeNormalDistance's d0).
+	ContactStencil stencil;
+	double gap = 0;  // signed normal distance [m], > 0 apart, < 0 penetrating
+	// Unit normal pointing from block j towards block i: the direction of the
+	// push a compressed contact gives block i. vertex-face: the outward normal
+	// of block j's face; edge-edge: minus the stencil's n. For both kinds
+	// gap = normal . (pointI - pointJ).
+	Vector3 normal = Vector3::UnitZ();
+	Vector3 pointI = Vector3::Zero();  // contact point on block i's feature [m]
+	Vector3 pointJ = Vector3::Zero();  // its counterpart on block j's feature [m]
+};
+
+struct PairContacts {
+	ContactType type = ContactType::VertexFace;
+	EntranceFeature entrance;
+	double separation = 0;              // of the entrance axis [m], <= d0
+	Vector3 normal = Vector3::UnitZ();  // entrance normal, unit, from A towards B
+	std::vector<SubContact> contacts;   // may be empty (e.g. corners hanging past a face)
+};
+
+// The pair's contacts, or nothing when the blocks are farther apart than
+// settings.contactDistance. `previous` is the pair's entrance feature of the
+// last step (None when new). Never returns NaN; throws nothing for valid
+// blocks of buildConvexPolyhedron.
+std::optional<PairContacts> detectPairContacts(const BlockGeometry& a, const BlockGeometry& b,
+                                               const DetectionSettings& settings,
+                                               const EntranceFeature& previous = {});
+
+}  // namespace dda

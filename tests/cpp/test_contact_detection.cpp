@@ -1,0 +1,875 @@
+// Tests of the pair narrow phase (pkg/dda/contact/PairDetection): is the pair
+// within the contact distance, its structural type, and its vertex-face and
+// edge-edge sub-contacts.
+//
+// Each of the seven structural types is placed once exactly (shapes with
+// exactly representable corners: boxes, octahedra and square prisms standing
+// on an edge, touching at a corner, an edge or a face) and once generically
+// (slightly apart or penetrating, turned by a random rotation of the whole
+// scene). Gaps are compared with closed forms; a box swept towards another
+// checks the hit/miss transition at exactly d0 (as libccd's boxbox tests);
+// random boxes and tetrahedra near contact check the invariants against a
+// brute-force separating-axis twin.
+#include "dda/contact/Distance.hpp"
+#include "dda/contact/Linearization.hpp"
+#include "dda/contact/PairDetection.hpp"
+#include "dda/geometry/ConvexPolyhedron.hpp"
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace {
+
+using dda::ContactKind;
+using dda::ContactType;
+using dda::DetectionSettings;
+using dda::EntranceFeature;
+using dda::PairContacts;
+using dda::SubContact;
+using dda::Vector3;
+using Matrix3 = Eigen::Matrix3d;
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kContactDistance = 1e-3;  // d0 [m] for the unit-sized blocks below
+constexpr double kLengthTolerance = 1e-8;  // [m]
+constexpr double kRoundoff = 1e-12;        // [m], round-off of unit-sized coordinates
+
+// A block: its topology and current corners, as the narrow phase sees it.
+struct Block {
+	dda::ConvexPolyhedron shape;
+	std::vector<Vector3> vertices;
+	Vector3 centroid = Vector3::Zero();
+	dda::BlockGeometry geometry() const { return {&shape, &vertices, centroid}; }
+};
+
+Block makeBlock(const std::vector<Vector3>& points) {
+	Block b;
+	b.shape = dda::buildConvexPolyhedron(points);
+	b.vertices = b.shape.vertices;
+	for (const Vector3& p : points) b.centroid += p;
+	b.centroid /= static_cast<double>(points.size());
+	return b;
+}
+
+// x -> R x + o applied to every corner.
+Block moved(const Block& b, const Matrix3& R, const Vector3& o) {
+	std::vector<Vector3> points;
+	for (const Vector3& p : b.vertices) points.push_back(R * p + o);
+	return makeBlock(points);
+}
+
+Block box(const Vector3& lower, const Vector3& upper) {
+	std::vector<Vector3> p;
+	for (int k = 0; k < 8; ++k)
+		p.emplace_back(k & 1 ? upper.x() : lower.x(), k & 2 ? upper.y() : lower.y(), k & 4 ? upper.z() : lower.z());
+	return makeBlock(p);
+}
+
+// Regular octahedron: corners centre +- r e_k (exact for exact input).
+Block octahedron(const Vector3& centre, double r) {
+	std::vector<Vector3> p;
+	for (int k = 0; k < 3; ++k) {
+		p.push_back(centre + r * Vector3::Unit(k));
+		p.push_back(centre - r * Vector3::Unit(k));
+	}
+	return makeBlock(p);
+}
+
+// Square prism along x, x in [x0, x1], cross-section the square |y| + |z - zc| <= 1
+// standing on an edge: its top edge is (y, z) = (0, zc + 1), its bottom edge
+// (0, zc - 1).
+Block prismAlongX(double x0, double x1, double zc) {
+	std::vector<Vector3> p;
+	for (double x : {x0, x1}) {
+		p.emplace_back(x, 0, zc + 1);
+		p.emplace_back(x, 1, zc);
+		p.emplace_back(x, 0, zc - 1);
+		p.emplace_back(x, -1, zc);
+	}
+	return makeBlock(p);
+}
+
+// The same prism along y: y in [y0, y1], |x| + |z - zc| <= 1.
+Block prismAlongY(double y0, double y1, double zc) {
+	std::vector<Vector3> p;
+	for (double y : {y0, y1}) {
+		p.emplace_back(0, y, zc + 1);
+		p.emplace_back(1, y, zc);
+		p.emplace_back(0, y, zc - 1);
+		p.emplace_back(-1, y, zc);
+	}
+	return makeBlock(p);
+}
+
+Matrix3 rotationAbout(const Vector3& axis, double angle) {
+	return Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix();
+}
+
+Matrix3 randomRotation(std::mt19937& rng) {
+	std::normal_distribution<double> normal(0.0, 1.0);
+	Eigen::Quaterniond q(normal(rng), normal(rng), normal(rng), normal(rng));
+	q.normalize();
+	return q.toRotationMatrix();
+}
+
+DetectionSettings settings(double d0 = kContactDistance) {
+	DetectionSettings s;
+	s.contactDistance = d0;
+	s.lengthTolerance = kLengthTolerance;
+	s.hysteresis = std::max(0.1 * d0, kLengthTolerance);
+	return s;
+}
+
+std::optional<PairContacts> detect(const Block& a, const Block& b, const DetectionSettings& s = settings(),
+                                   const EntranceFeature& previous = {}) {
+	return dda::detectPairContacts(a.geometry(), b.geometry(), s, previous);
+}
+
+int countKind(const PairContacts& r, ContactKind kind) {
+	return static_cast<int>(std::count_if(r.contacts.begin(), r.contacts.end(),
+	                                       [&](const SubContact& c) { return c.kind == kind; }));
+}
+
+std::string describe(const PairContacts& r) {
+	std::string s = std::string(dda::contactTypeName(r.type)) + " entrance " + std::to_string(r.entrance.kind) + "/" +
+	                std::to_string(r.entrance.feature) + "/" + std::to_string(r.entrance.other) + " sep " +
+	                std::to_string(r.separation) + " contacts:";
+	for (const SubContact& c : r.contacts)
+		s += std::string(c.kind == ContactKind::VertexFace ? " VF" : " EE") + (c.firstIsA ? "(A" : "(B") +
+		     std::to_string(c.feature1) + "," + std::to_string(c.feature2) + " gap " + std::to_string(c.gap) + ")";
+	return s;
+}
+
+// Invariants of every result: finite, gaps within d0, each gap the linearised
+// d0 of its stencil and normal . (pointI - pointJ), stencil points the corners
+// of the named features, vertex-face normals the face's outward normal and
+// gaps its plane distance, edge-edge gaps the distance of the edges' lines.
+void checkInvariants(const PairContacts& r, const Block& a, const Block& b, const DetectionSettings& s) {
+	SCOPED_TRACE(describe(r));
+	EXPECT_TRUE(std::isfinite(r.separation));
+	EXPECT_TRUE(r.normal.allFinite());
+	EXPECT_NEAR(r.normal.norm(), 1, 1e-12);
+	EXPECT_LE(r.separation, s.contactDistance);
+	for (const SubContact& c : r.contacts) {
+		const Block& bi = c.firstIsA ? a : b;
+		const Block& bj = c.firstIsA ? b : a;
+		EXPECT_TRUE(std::isfinite(c.gap));
+		EXPECT_TRUE(c.normal.allFinite() && c.pointI.allFinite() && c.pointJ.allFinite());
+		EXPECT_NEAR(c.normal.norm(), 1, 1e-12);
+		EXPECT_LE(c.gap, s.contactDistance + s.lengthTolerance);
+		EXPECT_EQ(c.kind, c.stencil.kind);
+		const dda::LinearizedDistance lin = dda::linearizeNormalDistance(c.stencil, bi.centroid, bj.centroid);
+		EXPECT_TRUE(lin.valid);
+		EXPECT_NEAR(c.gap, lin.d0, 1e-12 * std::max(1.0, std::abs(lin.d0)));
+		EXPECT_NEAR(c.gap, c.normal.dot(c.pointI - c.pointJ), kRoundoff);
+		if (c.kind == ContactKind::VertexFace) {
+			const std::vector<int>& face = bj.shape.faces.at(c.feature2);
+			EXPECT_EQ(c.stencil.points[0], bi.vertices.at(c.feature1));
+			EXPECT_EQ(c.pointI, bi.vertices.at(c.feature1));
+			for (int k = 1; k < 4; ++k) {
+				EXPECT_TRUE(std::any_of(face.begin(), face.end(),
+				                        [&](int v) { return bj.vertices[v] == c.stencil.points[k]; }));
+			}
+			const dda::VertexFaceResult vf = dda::vertexFaceDistance(c.pointI, bj.vertices, face, 0.0);
+			EXPECT_NEAR((vf.normal - c.normal).norm(), 0, 1e-9);
+			EXPECT_NEAR(c.gap, vf.distance, 1e-9);
+		} else {
+			const auto& e1 = bi.shape.edges.at(c.feature1);
+			const auto& e2 = bj.shape.edges.at(c.feature2);
+			EXPECT_EQ(c.stencil.points[0], bi.vertices[e1[0]]);
+			EXPECT_EQ(c.stencil.points[1], bi.vertices[e1[1]]);
+			EXPECT_EQ(c.stencil.points[2], bj.vertices[e2[0]]);
+			EXPECT_EQ(c.stencil.points[3], bj.vertices[e2[1]]);
+			const dda::EdgeEdgeResult ee =
+			    dda::edgeEdgeDistance(c.stencil.points[0], c.stencil.points[1], c.stencil.points[2],
+			                          c.stencil.points[3], -c.normal, s.lengthTolerance);
+			EXPECT_FALSE(ee.parallel);
+			EXPECT_TRUE(ee.interior);
+			EXPECT_NEAR(c.gap, ee.distance, kRoundoff);
+			EXPECT_NEAR((c.pointI - ee.closestI).norm(), 0, kRoundoff);
+			EXPECT_NEAR((c.pointJ - ee.closestJ).norm(), 0, kRoundoff);
+		}
+	}
+}
+
+// Detects, checks the invariants and the expected type; returns the result.
+PairContacts expectContact(const Block& a, const Block& b, ContactType type, const DetectionSettings& s = settings()) {
+	const std::optional<PairContacts> r = detect(a, b, s);
+	if (!r) {
+		ADD_FAILURE() << "expected a " << dda::contactTypeName(type) << " contact, got none";
+		return {};
+	}
+	SCOPED_TRACE(describe(*r));
+	checkInvariants(*r, a, b, s);
+	EXPECT_STREQ(dda::contactTypeName(r->type), dda::contactTypeName(type));
+	EXPECT_FALSE(r->contacts.empty());
+	return *r;
+}
+
+// The whole scene turned by a random rotation and moved: a generic placement.
+struct Scene {
+	Matrix3 R = Matrix3::Identity();
+	Vector3 o = Vector3::Zero();
+};
+std::vector<Scene> genericScenes(unsigned seed, int count) {
+	std::mt19937 rng(seed);
+	std::uniform_real_distribution<double> u(-3, 3);
+	std::vector<Scene> out;
+	for (int k = 0; k < count; ++k) out.push_back({randomRotation(rng), Vector3(u(rng), u(rng), u(rng))});
+	return out;
+}
+
+// ------------------------------------------------------------------ names
+
+TEST(ContactDetection, TypeNames) {
+	EXPECT_STREQ(dda::contactTypeName(ContactType::VertexVertex), "VV");
+	EXPECT_STREQ(dda::contactTypeName(ContactType::VertexEdge), "VE");
+	EXPECT_STREQ(dda::contactTypeName(ContactType::VertexFace), "VF");
+	EXPECT_STREQ(dda::contactTypeName(ContactType::EdgeEdgeCrossing), "EE");
+	EXPECT_STREQ(dda::contactTypeName(ContactType::EdgeEdgeParallel), "EEp");
+	EXPECT_STREQ(dda::contactTypeName(ContactType::EdgeFace), "EF");
+	EXPECT_STREQ(dda::contactTypeName(ContactType::FaceFace), "FF");
+}
+
+// ------------------------------------------------------------------ vertex-vertex
+
+TEST(ContactDetection, VertexVertexExactOctahedraCornerOnCorner) {
+	const Block a = octahedron(Vector3(0, 0, 0), 1);
+	const Block b = octahedron(Vector3(0, 0, 2), 1);  // bottom corner exactly on a's top corner
+	const PairContacts r = expectContact(a, b, ContactType::VertexVertex);
+	EXPECT_EQ(r.separation, 0);
+	for (const SubContact& c : r.contacts) {
+		EXPECT_EQ(c.gap, 0);
+		EXPECT_EQ(c.pointI, Vector3(0, 0, 1));
+	}
+}
+
+TEST(ContactDetection, VertexVertexExactCubesCornerOnCorner) {
+	const Block a = box(Vector3(0, 0, 0), Vector3(1, 1, 1));
+	const Block b = box(Vector3(1, 1, 1), Vector3(2, 2, 2));
+	const PairContacts r = expectContact(a, b, ContactType::VertexVertex);
+	ASSERT_EQ(r.contacts.size(), 1u);  // the coincident corner gives no second contact
+	EXPECT_EQ(r.contacts[0].gap, 0);
+	EXPECT_EQ(r.contacts[0].pointI, Vector3(1, 1, 1));
+	EXPECT_EQ(countKind(r, ContactKind::EdgeEdge), 0);  // collinear edges and crossings at corners: none
+}
+
+TEST(ContactDetection, VertexVertexGenericApartAndPenetrating) {
+	const Block a = octahedron(Vector3(0, 0, 0), 1);
+	// b's bottom corner at the origin, turned by 0.3 rad about a tilted axis.
+	const Block b0 = moved(octahedron(Vector3(0, 0, 1), 1), rotationAbout(Vector3(1, 2, 0.5), 0.3), Vector3::Zero());
+	for (double h : {4e-4, -2e-4}) {
+		for (const Scene& scene : genericScenes(21, 5)) {
+			const Block sa = moved(a, scene.R, scene.o);
+			const Block sb = moved(b0, scene.R, scene.R * Vector3(0.5e-4, -0.3e-4, 1 + h) + scene.o);
+			SCOPED_TRACE("h " + std::to_string(h));
+			const PairContacts r = expectContact(sa, sb, ContactType::VertexVertex);
+			// Apart: every gap positive. Penetrating: b's corner is inside a (a's
+			// corner may still be outside b's turned faces).
+			const auto negative = [](const SubContact& c) { return c.gap < 0; };
+			if (h > 0) EXPECT_TRUE(std::none_of(r.contacts.begin(), r.contacts.end(), negative));
+			else EXPECT_TRUE(std::any_of(r.contacts.begin(), r.contacts.end(), negative));
+		}
+	}
+}
+
+// ------------------------------------------------------------------ vertex-edge
+
+TEST(ContactDetection, VertexEdgeExactCornerOnEdge) {
+	const Block a = prismAlongX(-1, 1, 0);             // top edge (x, 0, 1)
+	const Block b = octahedron(Vector3(0.25, 0, 2), 1);  // bottom corner (0.25, 0, 1)
+	const PairContacts r = expectContact(a, b, ContactType::VertexEdge);
+	for (const SubContact& c : r.contacts) {
+		EXPECT_EQ(c.gap, 0);
+		EXPECT_NEAR((c.pointI - Vector3(0.25, 0, 1)).norm(), 0, kRoundoff);
+	}
+}
+
+TEST(ContactDetection, VertexEdgeGenericCornerNearMiddleOfEdge) {
+	// b: a cube standing on a corner (body diagonal vertical), that corner near
+	// the middle of the top edge y = z = 0.5 of the box a.
+	const Block a = box(Vector3(-0.5, -0.5, -0.5), Vector3(0.5, 0.5, 0.5));
+	const Matrix3 tilt = Eigen::Quaterniond::FromTwoVectors(Vector3(1, 1, 1), Vector3(0, 0, 1)).toRotationMatrix();
+	const Block cube = moved(box(Vector3(0, 0, 0), Vector3(0.6, 0.6, 0.6)), rotationAbout(Vector3::UnitZ(), 0.4) * tilt,
+	                         Vector3::Zero());  // corner 0 at the origin, the lowest
+	for (const Vector3& offset : {Vector3(0.1, 0.5 + 2e-4, 0.5 + 3e-4), Vector3(-0.2, 0.5 - 1e-4, 0.5 - 2e-4)}) {
+		for (const Scene& scene : genericScenes(31, 5)) {
+			const PairContacts r =
+			    expectContact(moved(a, scene.R, scene.o), moved(cube, scene.R, scene.R * offset + scene.o),
+			                  ContactType::VertexEdge);
+			for (const SubContact& c : r.contacts) EXPECT_EQ(c.gap < 0, offset.z() < 0.5);
+		}
+	}
+}
+
+// ------------------------------------------------------------------ vertex-face
+
+TEST(ContactDetection, VertexFaceExactCornerOnFace) {
+	const Block a = box(Vector3(-2, -2, -1), Vector3(2, 2, 0));
+	const Block b = octahedron(Vector3(0.3, -0.7, 1), 1);  // bottom corner (0.3, -0.7, 0)
+	const PairContacts r = expectContact(a, b, ContactType::VertexFace);
+	ASSERT_EQ(r.contacts.size(), 1u);
+	const SubContact& c = r.contacts[0];
+	EXPECT_EQ(c.kind, ContactKind::VertexFace);
+	EXPECT_FALSE(c.firstIsA);  // b's corner on a's face
+	EXPECT_EQ(c.gap, 0);
+	EXPECT_EQ(c.pointI, Vector3(0.3, -0.7, 0));
+	EXPECT_EQ(c.normal, Vector3(0, 0, 1));
+}
+
+TEST(ContactDetection, VertexFaceGenericTiltedCube) {
+	const Block a = box(Vector3(-2, -2, -1), Vector3(2, 2, 0));
+	const Matrix3 tilt = Eigen::Quaterniond::FromTwoVectors(Vector3(1, 1, 1), Vector3(0, 0, 1)).toRotationMatrix();
+	const Block cube = moved(box(Vector3(0, 0, 0), Vector3(1, 1, 1)), rotationAbout(Vector3::UnitZ(), 1.1) * tilt,
+	                         Vector3::Zero());
+	for (double h : {7e-4, 0.0, -5e-4}) {
+		for (const Scene& scene : genericScenes(41, 5)) {
+			const PairContacts r =
+			    expectContact(moved(a, scene.R, scene.o), moved(cube, scene.R, scene.R * Vector3(0.2, 0.4, h) + scene.o),
+			                  ContactType::VertexFace);
+			ASSERT_EQ(r.contacts.size(), 1u);
+			EXPECT_NEAR(r.contacts[0].gap, h, kRoundoff * 10);
+		}
+	}
+}
+
+// ------------------------------------------------------------------ edge-edge
+
+TEST(ContactDetection, EdgeEdgeCrossingExact) {
+	const Block a = prismAlongX(-1, 1, 0);  // top edge (x, 0, 1)
+	const Block b = prismAlongY(-1, 1, 2);  // bottom edge (0, y, 1)
+	const PairContacts r = expectContact(a, b, ContactType::EdgeEdgeCrossing);
+	EXPECT_EQ(r.entrance.kind, EntranceFeature::EdgePair);
+	ASSERT_EQ(r.contacts.size(), 1u);
+	const SubContact& c = r.contacts[0];
+	EXPECT_EQ(c.kind, ContactKind::EdgeEdge);
+	EXPECT_EQ(c.gap, 0);
+	EXPECT_EQ(c.pointI, Vector3(0, 0, 1));
+	EXPECT_EQ(c.pointJ, Vector3(0, 0, 1));
+}
+
+TEST(ContactDetection, EdgeEdgeCrossingGenericAtAnAngle) {
+	const Block a = prismAlongX(-1, 1, 0);
+	const Block b0 = moved(prismAlongY(-1, 1, 2), rotationAbout(Vector3::UnitZ(), 0.5), Vector3(0.2, 0.1, 0));
+	for (double h : {6e-4, -3e-4}) {
+		for (const Scene& scene : genericScenes(51, 5)) {
+			const Block sa = moved(a, scene.R, scene.o);
+			const Block sb = moved(b0, scene.R, scene.R * Vector3(0, 0, h) + scene.o);
+			const PairContacts r = expectContact(sa, sb, ContactType::EdgeEdgeCrossing);
+			EXPECT_EQ(r.entrance.kind, EntranceFeature::EdgePair);
+			ASSERT_EQ(r.contacts.size(), 1u);
+			EXPECT_EQ(r.contacts[0].kind, ContactKind::EdgeEdge);
+			EXPECT_NEAR(r.contacts[0].gap, h, 1e-11);  // both edges horizontal: the line distance is h
+			EXPECT_NEAR(r.separation, h, 1e-11);
+			// The normal pushes block i (a) down, away from b.
+			EXPECT_TRUE(r.contacts[0].firstIsA);
+			EXPECT_NEAR((r.contacts[0].normal - scene.R * Vector3(0, 0, -1)).norm(), 0, 1e-12);
+		}
+	}
+}
+
+TEST(ContactDetection, EdgeEdgeParallelExactEdgeOnEdge) {
+	const Block a = prismAlongX(-1, 1, 0);       // top edge x in [-1, 1]
+	const Block b = prismAlongX(-0.5, 1.5, 2);   // bottom edge x in [-0.5, 1.5], on a's top edge
+	const PairContacts r = expectContact(a, b, ContactType::EdgeEdgeParallel);
+	EXPECT_EQ(countKind(r, ContactKind::EdgeEdge), 0);
+	EXPECT_EQ(r.contacts.size(), 2u);  // b's corner (-0.5, 0, 1) and a's corner (1, 0, 1)
+	for (const SubContact& c : r.contacts) EXPECT_EQ(c.gap, 0);
+}
+
+TEST(ContactDetection, EdgeEdgeParallelGeneric) {
+	const Block a = prismAlongX(-1, 1, 0);
+	const Block b0 = prismAlongX(-0.5, 1.5, 2);
+	for (double h : {8e-4, -4e-4}) {
+		for (const Scene& scene : genericScenes(61, 5)) {
+			const PairContacts r =
+			    expectContact(moved(a, scene.R, scene.o), moved(b0, scene.R, scene.R * Vector3(0, 0, h) + scene.o),
+			                  ContactType::EdgeEdgeParallel);
+			// The two corners at the ends of the overlap, against the faces at
+			// 45 degrees: gap h / sqrt(2). Penetrating, b's end edges also dip
+			// below a's top edge: short edge-edge contacts, never between the
+			// parallel edges (checked with the invariants).
+			EXPECT_EQ(countKind(r, ContactKind::VertexFace), 2);
+			if (h > 0) EXPECT_EQ(countKind(r, ContactKind::EdgeEdge), 0);
+			for (const SubContact& c : r.contacts) {
+				if (c.kind == ContactKind::VertexFace) EXPECT_NEAR(c.gap, h / std::sqrt(2.0), 1e-11);
+				else EXPECT_TRUE(c.gap < 0 && c.gap >= h);
+			}
+		}
+	}
+}
+
+// ------------------------------------------------------------------ edge-face
+
+TEST(ContactDetection, EdgeFaceExactPrismOnFloor) {
+	const Block a = box(Vector3(-2, -2, -1), Vector3(2, 2, 0));
+	const Block b = prismAlongX(-1, 1, 1);  // bottom edge (x, 0, 0)
+	const PairContacts r = expectContact(a, b, ContactType::EdgeFace);
+	EXPECT_EQ(r.entrance.kind, EntranceFeature::FaceOfA);
+	ASSERT_EQ(r.contacts.size(), 2u);
+	for (const SubContact& c : r.contacts) {
+		EXPECT_EQ(c.gap, 0);
+		EXPECT_FALSE(c.firstIsA);
+	}
+}
+
+TEST(ContactDetection, EdgeFaceGenericTiltedPrism) {
+	const Block a = box(Vector3(-2, -2, -1), Vector3(2, 2, 0));
+	// Prism along x turned about z and rocked slightly about its bottom edge.
+	const Matrix3 turn = rotationAbout(Vector3::UnitZ(), 0.7) * rotationAbout(Vector3::UnitX(), 0.2);
+	const Block b0 = moved(prismAlongX(-1, 1, 1), turn, Vector3(0.3, 0.2, 0));
+	for (double h : {5e-4, -5e-4}) {
+		for (const Scene& scene : genericScenes(71, 5)) {
+			const PairContacts r =
+			    expectContact(moved(a, scene.R, scene.o), moved(b0, scene.R, scene.R * Vector3(0, 0, h) + scene.o),
+			                  ContactType::EdgeFace);
+			ASSERT_EQ(r.contacts.size(), 2u);
+			for (const SubContact& c : r.contacts) EXPECT_NEAR(c.gap, h, 1e-11);
+		}
+	}
+}
+
+// ------------------------------------------------------------------ face-face
+
+TEST(ContactDetection, FaceFaceExactIdenticalCubesStacked) {
+	const Block a = box(Vector3(0, 0, 0), Vector3(1, 1, 1));
+	const Block b = box(Vector3(0, 0, 1), Vector3(1, 1, 2));
+	const PairContacts r = expectContact(a, b, ContactType::FaceFace);
+	EXPECT_EQ(r.entrance.kind, EntranceFeature::FaceOfA);  // tie: A before B
+	EXPECT_EQ(r.normal, Vector3(0, 0, 1));
+	ASSERT_EQ(r.contacts.size(), 4u);  // b's 4 bottom corners; a's coincident corners give none
+	for (const SubContact& c : r.contacts) {
+		EXPECT_EQ(c.kind, ContactKind::VertexFace);
+		EXPECT_FALSE(c.firstIsA);
+		EXPECT_EQ(c.gap, 0);
+	}
+}
+
+TEST(ContactDetection, FaceFaceExactCoplanarOffsetFaces) {
+	const Block a = box(Vector3(0, 0, 0), Vector3(1, 1, 1));
+	const Block b = box(Vector3(0.5, 0.25, 1), Vector3(1.5, 1.25, 2));
+	const PairContacts r = expectContact(a, b, ContactType::FaceFace);
+	EXPECT_EQ(r.contacts.size(), 4u);
+	EXPECT_EQ(countKind(r, ContactKind::EdgeEdge), 2);  // b's edges cross a's top edges at 2 points
+	EXPECT_EQ(countKind(r, ContactKind::VertexFace), 2);  // 1 corner of b inside a's top face, 1 of a's inside b's bottom
+	for (const SubContact& c : r.contacts) EXPECT_EQ(c.gap, 0);
+}
+
+TEST(ContactDetection, FaceFaceGenericTurnedCube) {
+	const Block a = box(Vector3(0, 0, 0), Vector3(1, 1, 1));
+	const Block b0 = moved(box(Vector3(-0.3, -0.3, 0), Vector3(0.3, 0.3, 0.6)), rotationAbout(Vector3::UnitZ(), 0.35),
+	                       Vector3(0.55, 0.45, 1));
+	for (double h : {6e-4, -2e-4}) {
+		for (const Scene& scene : genericScenes(81, 5)) {
+			const PairContacts r =
+			    expectContact(moved(a, scene.R, scene.o), moved(b0, scene.R, scene.R * Vector3(0, 0, h) + scene.o),
+			                  ContactType::FaceFace);
+			ASSERT_EQ(r.contacts.size(), 4u);
+			for (const SubContact& c : r.contacts) EXPECT_NEAR(c.gap, h, 1e-11);
+		}
+	}
+}
+
+// A cube turned 45 degrees about z on an identical cube: the two squares cross
+// at the 8 corners of an octagon, each an edge-edge contact; no corner lies
+// over the other square, so no vertex-face contacts.
+TEST(ContactDetection, TurnedCubeOnCubeGivesEightEdgeEdgeContactsAtOctagonCorners) {
+	const Block a = box(Vector3(-0.5, -0.5, -1), Vector3(0.5, 0.5, 0));
+	const Matrix3 R = rotationAbout(Vector3::UnitZ(), kPi / 4);
+	const double c = std::sqrt(0.5) - 0.5;  // octagon corners at (+-0.5, +-c), (+-c, +-0.5)
+	for (double h : {3e-4, 0.0, -3e-4}) {
+		const Block b = moved(box(Vector3(-0.5, -0.5, 0), Vector3(0.5, 0.5, 1)), R, Vector3(0, 0, h));
+		SCOPED_TRACE("h " + std::to_string(h));
+		const PairContacts r = expectContact(a, b, ContactType::FaceFace);
+		ASSERT_EQ(r.contacts.size(), 8u);
+		EXPECT_EQ(countKind(r, ContactKind::EdgeEdge), 8);
+		for (const SubContact& s : r.contacts) {
+			EXPECT_NEAR(s.gap, h, kRoundoff);
+			const Vector3& p = s.firstIsA ? s.pointI : s.pointJ;  // on a's top edges
+			const bool onX = std::abs(std::abs(p.x()) - 0.5) < 1e-12 && std::abs(std::abs(p.y()) - c) < 1e-12;
+			const bool onY = std::abs(std::abs(p.y()) - 0.5) < 1e-12 && std::abs(std::abs(p.x()) - c) < 1e-12;
+			EXPECT_TRUE(onX || onY) << p.transpose();
+			EXPECT_NEAR(p.z(), 0, 1e-15);
+		}
+	}
+}
+
+TEST(ContactDetection, SmallCubeOnFloorGivesFourVertexFaceContactsOnFloorTop) {
+	const Block floor = box(Vector3(-5, -5, -1), Vector3(5, 5, 0));
+	for (double h : {5e-4, 0.0, -5e-4}) {
+		const Block cube = moved(box(Vector3(-0.5, -0.5, 0), Vector3(0.5, 0.5, 1)), rotationAbout(Vector3::UnitZ(), 0.3),
+		                         Vector3(1, 2, h));
+		SCOPED_TRACE("h " + std::to_string(h));
+		for (bool floorFirst : {true, false}) {
+			const Block& a = floorFirst ? floor : cube;
+			const Block& b = floorFirst ? cube : floor;
+			const PairContacts r = expectContact(a, b, ContactType::FaceFace);
+			EXPECT_EQ(r.entrance.kind, floorFirst ? EntranceFeature::FaceOfA : EntranceFeature::FaceOfB);
+			ASSERT_EQ(r.contacts.size(), 4u);
+			for (const SubContact& c : r.contacts) {
+				EXPECT_EQ(c.kind, ContactKind::VertexFace);
+				EXPECT_EQ(c.firstIsA, !floorFirst);  // the cube's corners
+				EXPECT_EQ(c.feature2, r.entrance.feature);
+				EXPECT_EQ(c.normal, Vector3(0, 0, 1));
+				EXPECT_NEAR(c.gap, h, 1e-15);
+				EXPECT_NEAR(c.pointI.z(), h, 1e-15);
+			}
+		}
+	}
+}
+
+// ------------------------------------------------------------------ zero contact distance
+
+// Exact placements are touching, not apart, with d0 = 0: the sign of a corner
+// exactly on a plane (or of two exactly intersecting edges) is decided exactly.
+TEST(ContactDetection, ExactPlacementsAreFoundWithZeroContactDistance) {
+	const DetectionSettings s = settings(0.0);
+	const Block floor = box(Vector3(-2, -2, -1), Vector3(2, 2, 0));
+	const Block px = prismAlongX(-1, 1, 0);
+	struct Case {
+		Block a, b;
+		ContactType type;
+	};
+	const std::vector<Case> cases{
+	    {octahedron(Vector3(0, 0, 0), 1), octahedron(Vector3(0, 0, 2), 1), ContactType::VertexVertex},
+	    {px, octahedron(Vector3(0.25, 0, 2), 1), ContactType::VertexEdge},
+	    {floor, octahedron(Vector3(0.3, -0.7, 1), 1), ContactType::VertexFace},
+	    {px, prismAlongY(-1, 1, 2), ContactType::EdgeEdgeCrossing},
+	    {px, prismAlongX(-0.5, 1.5, 2), ContactType::EdgeEdgeParallel},
+	    {floor, prismAlongX(-1, 1, 1), ContactType::EdgeFace},
+	    {box(Vector3(0, 0, 0), Vector3(1, 1, 1)), box(Vector3(0, 0, 1), Vector3(1, 1, 2)), ContactType::FaceFace},
+	};
+	for (const Case& c : cases) {
+		SCOPED_TRACE(dda::contactTypeName(c.type));
+		const PairContacts r = expectContact(c.a, c.b, c.type, s);
+		EXPECT_EQ(r.separation, 0);
+		for (const SubContact& sub : r.contacts) EXPECT_EQ(sub.gap, 0);
+	}
+}
+
+// A corner exactly on a slanted face (x/2 + y/3 + z/5 = 1, every value an
+// exact binary fraction): the double distance from the face plane is round-off
+// of either sign, the exact predicate makes it 0, so the pair touches.
+TEST(ContactDetection, CornerExactlyOnSlantedFaceTouchesWithZeroContactDistance) {
+	const DetectionSettings s = settings(0.0);
+	const Block a = makeBlock({{0, 0, 0}, {2, 0, 0}, {0, 3, 0}, {0, 0, 5}});
+	const Vector3 out(1.5, 1, 0.6);  // along the face's outward normal (15, 10, 6)
+	for (const Vector3& p : {Vector3(0.5, 0.75, 2.5), Vector3(1, 0.75, 1.25), Vector3(0.25, 1.5, 1.875),
+	                         Vector3(1.5, 0.375, 0.625), Vector3(0.125, 2.25, 0.9375)}) {
+		ASSERT_EQ(p.x() / 2 + p.y() / 3 + p.z() / 5, 1);
+		const Block b = makeBlock(
+		    {p, p + out + Vector3(0.3, 0, 0), p + out + Vector3(0, 0.3, 0), p + out + Vector3(0, 0, 0.3)});
+		SCOPED_TRACE("corner " + std::to_string(p.x()) + " " + std::to_string(p.y()) + " " + std::to_string(p.z()));
+		const PairContacts r = expectContact(a, b, ContactType::VertexFace, s);
+		EXPECT_EQ(r.separation, 0);
+		ASSERT_EQ(r.contacts.size(), 1u);
+		EXPECT_EQ(r.contacts[0].pointI, p);
+		EXPECT_NEAR(r.contacts[0].gap, 0, 1e-15);
+	}
+}
+
+// Two identical cubes turned by a random rotation, the upper one built on the
+// lower one's top corners (the same doubles): the top face is planar only to
+// round-off, yet with d0 = 0 the pair touches face to face, corners coincide
+// and give one contact each.
+TEST(ContactDetection, TurnedCubesSharingCornersTouchWithZeroContactDistance) {
+	const DetectionSettings s = settings(0.0);
+	std::mt19937 rng(7);
+	for (int trial = 0; trial < 20; ++trial) {
+		const Block a =
+		    moved(box(Vector3(-0.5, -0.5, -0.5), Vector3(0.5, 0.5, 0.5)), randomRotation(rng), Vector3(0.3, -0.2, 0.1));
+		std::vector<Vector3> upper;
+		for (int k = 4; k < 8; ++k) upper.push_back(a.vertices[k]);                                  // a's top corners
+		for (int k = 4; k < 8; ++k) upper.push_back(2 * a.vertices[k] - a.vertices[k - 4]);  // one height up
+		const Block b = makeBlock(upper);
+		SCOPED_TRACE("trial " + std::to_string(trial));
+		const PairContacts r = expectContact(a, b, ContactType::FaceFace, s);
+		EXPECT_EQ(r.contacts.size(), 4u);
+		for (const SubContact& c : r.contacts) EXPECT_NEAR(c.gap, 0, 1e-15);
+	}
+}
+
+// ------------------------------------------------------------------ far pairs, sweep
+
+// Box b swept along x towards box a (libccd boxbox style): contact exactly when
+// the gap is at most d0. All values are exact binary fractions.
+TEST(ContactDetection, SweepAlongAxisHitsExactlyAtContactDistance) {
+	const double d0 = 0.125;
+	const DetectionSettings s = settings(d0);
+	const Block a = box(Vector3(0, 0, 0), Vector3(1, 1, 1));
+	const double step = std::ldexp(1.0, -30);
+	for (double gap : {1.0, 0.25, d0 + step, d0, d0 - step, 0.0625, 0.0, -step, -0.0625, -0.25}) {
+		const Block b = box(Vector3(1 + gap, 0.25, 0.5), Vector3(2 + gap, 1.25, 1.5));
+		const std::optional<PairContacts> r = detect(a, b, s);
+		SCOPED_TRACE("gap " + std::to_string(gap));
+		ASSERT_EQ(r.has_value(), gap <= d0);
+		if (!r) continue;
+		checkInvariants(*r, a, b, s);
+		EXPECT_EQ(r->separation, gap);
+		EXPECT_STREQ(dda::contactTypeName(r->type), "FF");
+		EXPECT_EQ(r->entrance.kind, EntranceFeature::FaceOfA);
+		EXPECT_EQ(r->normal, Vector3(1, 0, 0));
+		EXPECT_GE(r->contacts.size(), 1u);
+		for (const SubContact& c : r->contacts) EXPECT_EQ(c.gap, gap);
+	}
+}
+
+// The same along a skew line: for axis-aligned boxes the separation is the
+// largest per-axis gap.
+TEST(ContactDetection, SweepAlongSkewLineHitsAtLargestAxisGap) {
+	const double d0 = 0.125;
+	const DetectionSettings s = settings(d0);
+	const Block a = box(Vector3(0, 0, 0), Vector3(1, 1, 1));
+	const Vector3 direction(1, 0.5, -0.25);
+	for (int k = -40; k <= 40; ++k) {
+		const double t = 1 + k / 64.0;
+		const Vector3 offset = t * direction;
+		const Block b = moved(box(Vector3(0, 0, 0), Vector3(1, 1, 1)), Matrix3::Identity(), offset);
+		const double expected = offset.cwiseAbs().maxCoeff() - 1;  // largest per-axis gap
+		const std::optional<PairContacts> r = detect(a, b, s);
+		SCOPED_TRACE("t " + std::to_string(t));
+		ASSERT_EQ(r.has_value(), expected <= d0);
+		if (!r) continue;
+		checkInvariants(*r, a, b, s);
+		EXPECT_NEAR(r->separation, expected, 1e-15);
+	}
+}
+
+TEST(ContactDetection, PairFartherThanContactDistanceGivesNothing) {
+	const Block a = octahedron(Vector3(0, 0, 0), 1);
+	for (const Scene& scene : genericScenes(91, 5)) {
+		// Corner above corner, gap 2 d0: no axis is within d0.
+		const Block b = moved(octahedron(Vector3(0, 0, 2 + 2 * kContactDistance), 1), scene.R, scene.o);
+		EXPECT_FALSE(detect(moved(a, scene.R, scene.o), b).has_value());
+	}
+	// Crossing edges 2 d0 apart.
+	const Block p = prismAlongX(-1, 1, 0);
+	const Block q = prismAlongY(-1, 1, 2 + 2 * kContactDistance);
+	EXPECT_FALSE(detect(p, q).has_value());
+	EXPECT_TRUE(detect(p, prismAlongY(-1, 1, 2 + 0.5 * kContactDistance)).has_value());
+}
+
+// ------------------------------------------------------------------ symmetry, hysteresis
+
+void expectMirrored(const PairContacts& ab, const PairContacts& ba) {
+	EXPECT_EQ(ab.type, ba.type);
+	EXPECT_EQ(ab.separation, ba.separation);
+	EXPECT_NEAR((ab.normal + ba.normal).norm(), 0, 1e-15);
+	switch (ab.entrance.kind) {
+		case EntranceFeature::FaceOfA: EXPECT_EQ(ba.entrance.kind, EntranceFeature::FaceOfB); break;
+		case EntranceFeature::FaceOfB: EXPECT_EQ(ba.entrance.kind, EntranceFeature::FaceOfA); break;
+		case EntranceFeature::EdgePair: EXPECT_EQ(ba.entrance.kind, EntranceFeature::EdgePair); break;
+		case EntranceFeature::None: ADD_FAILURE() << "no entrance"; break;
+	}
+	if (ab.entrance.kind == EntranceFeature::EdgePair) {
+		EXPECT_EQ(ab.entrance.feature, ba.entrance.other);
+		EXPECT_EQ(ab.entrance.other, ba.entrance.feature);
+	} else {
+		EXPECT_EQ(ab.entrance.feature, ba.entrance.feature);
+	}
+	ASSERT_EQ(ab.contacts.size(), ba.contacts.size());
+	for (std::size_t k = 0; k < ab.contacts.size(); ++k) {
+		const SubContact &x = ab.contacts[k], &y = ba.contacts[k];
+		EXPECT_EQ(x.kind, y.kind);
+		EXPECT_NEAR(x.gap, y.gap, 1e-15);
+		if (x.firstIsA == !y.firstIsA) {  // the same block owns the vertex or edge 1
+			EXPECT_EQ(x.feature1, y.feature1);
+			EXPECT_EQ(x.feature2, y.feature2);
+			EXPECT_NEAR((x.normal - y.normal).norm(), 0, 1e-15);
+			EXPECT_EQ(x.pointI, y.pointI);
+			EXPECT_EQ(x.pointJ, y.pointJ);
+		} else {  // an edge entrance: block i is A in both orders, roles swap
+			EXPECT_EQ(x.kind, ContactKind::EdgeEdge);
+			EXPECT_EQ(x.feature1, y.feature2);
+			EXPECT_EQ(x.feature2, y.feature1);
+			EXPECT_NEAR((x.normal + y.normal).norm(), 0, 1e-15);
+			EXPECT_NEAR((x.pointI - y.pointJ).norm(), 0, 1e-15);
+			EXPECT_NEAR((x.pointJ - y.pointI).norm(), 0, 1e-15);
+		}
+	}
+}
+
+TEST(ContactDetection, SwappingBlocksMirrorsTheResult) {
+	const Block floor = box(Vector3(-2, -2, -1), Vector3(2, 2, 0));
+	const Block turned = moved(box(Vector3(-0.3, -0.3, 0), Vector3(0.3, 0.3, 0.6)),
+	                           rotationAbout(Vector3(0.1, 0.2, 1), 0.35),
+	                           Vector3(0.5, 0.4, -2e-4));
+	const Block p = prismAlongX(-1, 1, 0);
+	const Block q = moved(prismAlongY(-1, 1, 2), rotationAbout(Vector3::UnitZ(), 0.5), Vector3(0.2, 0.1, -1e-4));
+	const Block oct = octahedron(Vector3(0.3, -0.2, 1 + 3e-4), 1);
+	const std::vector<std::pair<const Block*, const Block*>> pairs{
+	    {&floor, &turned}, {&p, &q}, {&floor, &oct}, {&p, &oct}};
+	for (const auto& [a, b] : pairs) {
+		for (const Scene& scene : genericScenes(101, 3)) {
+			const Block sa = moved(*a, scene.R, scene.o), sb = moved(*b, scene.R, scene.o);
+			const std::optional<PairContacts> ab = detect(sa, sb), ba = detect(sb, sa);
+			ASSERT_TRUE(ab && ba);
+			SCOPED_TRACE(describe(*ab) + " | " + describe(*ba));
+			EXPECT_FALSE(ab->contacts.empty());
+			expectMirrored(*ab, *ba);
+		}
+	}
+}
+
+TEST(ContactDetection, HysteresisKeepsPreviousEntranceFaceOnTie) {
+	const Block a = box(Vector3(0, 0, 0), Vector3(1, 1, 1));
+	const Block b = box(Vector3(0.25, 0, 1), Vector3(1.25, 1, 2));
+	const std::optional<PairContacts> fresh = detect(a, b);
+	ASSERT_TRUE(fresh);
+	EXPECT_EQ(fresh->entrance.kind, EntranceFeature::FaceOfA);  // tie: A first
+	int bottomOfB = -1;
+	for (std::size_t f = 0; f < b.shape.faces.size(); ++f)
+		if (dda::faceNormal(b.vertices, b.shape.faces[f]).z() < -0.5) bottomOfB = static_cast<int>(f);
+	ASSERT_GE(bottomOfB, 0);
+	const EntranceFeature previous{EntranceFeature::FaceOfB, bottomOfB, -1};
+	const std::optional<PairContacts> kept = detect(a, b, settings(), previous);
+	ASSERT_TRUE(kept);
+	checkInvariants(*kept, a, b, settings());
+	EXPECT_EQ(kept->entrance, previous);
+	EXPECT_EQ(kept->normal, Vector3(0, 0, 1));
+	ASSERT_EQ(kept->contacts.size(), 4u);
+	for (const SubContact& c : kept->contacts) {
+		EXPECT_EQ(c.kind, ContactKind::VertexFace);
+		if (c.firstIsA) EXPECT_EQ(c.feature2, bottomOfB);  // a's corners on b's bottom face
+	}
+	EXPECT_EQ(std::count_if(kept->contacts.begin(), kept->contacts.end(), [](const SubContact& c) { return c.firstIsA; }),
+	          2);
+
+	// b tilted so that its bottom face is 0.4 hysteresis worse than a's top: kept;
+	// 3 hysteresis worse: the best face takes over.
+	const double hysteresis = settings().hysteresis;
+	for (double worse : {0.4 * hysteresis, 3 * hysteresis}) {
+		// Turning b so that its bottom rises towards x = 1.25 by slope tan(angle),
+		// its lowest corner (x = 0.25) 1e-5 above a: b's bottom plane passes
+		// 0.25 tan(angle) lower at a's corners x = 0, so its separation is
+		// about that much worse than a's top face's (1e-5).
+		const double angle = std::atan(4 * worse);
+		const Block tilted = moved(b, rotationAbout(Vector3::UnitY(), -angle), Vector3::Zero());
+		const Block lifted = moved(tilted, Matrix3::Identity(),
+		                           Vector3(0, 0, 1 - tilted.vertices[0].z() + 1e-5));  // lowest corner 1e-5 above a
+		const std::optional<PairContacts> r = detect(a, lifted, settings(), previous);
+		ASSERT_TRUE(r);
+		SCOPED_TRACE("worse " + std::to_string(worse) + " " + describe(*r));
+		checkInvariants(*r, a, lifted, settings());
+		if (worse < hysteresis) {
+			EXPECT_EQ(r->entrance, previous);
+		} else {
+			EXPECT_EQ(r->entrance.kind, EntranceFeature::FaceOfA);
+		}
+	}
+}
+
+// ------------------------------------------------------------------ randomized
+
+// Independent twin: the separation along every face normal and every edge
+// cross product, in both orientations.
+double bruteForceSeparation(const Block& a, const Block& b) {
+	std::vector<Vector3> axes;
+	for (const Block* x : {&a, &b})
+		for (const auto& face : x->shape.faces) axes.push_back(dda::faceNormal(x->vertices, face));
+	for (const auto& ea : a.shape.edges) {
+		for (const auto& eb : b.shape.edges) {
+			const Vector3 c = (a.vertices[ea[1]] - a.vertices[ea[0]]).cross(b.vertices[eb[1]] - b.vertices[eb[0]]);
+			if (c.norm() > 1e-6) axes.push_back(c.normalized());
+		}
+	}
+	double best = -std::numeric_limits<double>::infinity();
+	for (const Vector3& n : axes) {
+		double minA = 1e300, maxA = -1e300, minB = 1e300, maxB = -1e300;
+		for (const Vector3& x : a.vertices) {
+			minA = std::min(minA, n.dot(x));
+			maxA = std::max(maxA, n.dot(x));
+		}
+		for (const Vector3& x : b.vertices) {
+			minB = std::min(minB, n.dot(x));
+			maxB = std::max(maxB, n.dot(x));
+		}
+		best = std::max({best, minB - maxA, minA - maxB});
+	}
+	return best;
+}
+
+// Is some corner of `inner` inside `outer` by more than `margin` [m]?
+bool cornerInside(const Block& inner, const Block& outer, double margin) {
+	for (const Vector3& p : inner.vertices) {
+		bool inside = true;
+		for (const auto& face : outer.shape.faces) {
+			const Vector3 n = dda::faceNormal(outer.vertices, face);
+			if (n.dot(p - outer.vertices[face[0]]) > -margin) inside = false;
+		}
+		if (inside) return true;
+	}
+	return false;
+}
+
+Block randomShape(std::mt19937& rng) {
+	std::uniform_real_distribution<double> size(0.4, 1.5);
+	std::normal_distribution<double> normal(0.0, 1.0);
+	if (rng() % 2) {
+		const Vector3 half(size(rng) / 2, size(rng) / 2, size(rng) / 2);
+		return moved(box(-half, half), randomRotation(rng), Vector3::Zero());
+	}
+	for (;;) {  // a tetrahedron that is not too flat
+		std::vector<Vector3> p;
+		for (int k = 0; k < 4; ++k) p.emplace_back(normal(rng), normal(rng), normal(rng));
+		const double volume = std::abs((p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0]))) / 6;
+		if (volume < 0.1) continue;
+		Vector3 mean = (p[0] + p[1] + p[2] + p[3]) / 4;
+		for (Vector3& x : p) x -= mean;
+		return makeBlock(p);
+	}
+}
+
+TEST(ContactDetection, RandomBoxesAndTetrahedraNearContact) {
+	std::mt19937 rng(20240611);
+	std::normal_distribution<double> normal(0.0, 1.0);
+	std::uniform_real_distribution<double> jitter(-0.02, 0.02);
+	const double d0 = 0.01;
+	int found = 0, overlapping = 0, far = 0;
+	for (int trial = 0; trial < 200; ++trial) {
+		const Block a = randomShape(rng);
+		const Block b0 = randomShape(rng);
+		const Vector3 direction = Vector3(normal(rng), normal(rng), normal(rng)).normalized();
+		// Touching distance along `direction` by bisection of the convex,
+		// increasing separation.
+		double lo = 0, hi = 10;
+		for (int k = 0; k < 60; ++k) {
+			const double mid = 0.5 * (lo + hi);
+			(bruteForceSeparation(a, moved(b0, Matrix3::Identity(), mid * direction)) > 0 ? hi : lo) = mid;
+		}
+		const Block b = moved(b0, Matrix3::Identity(), (hi + jitter(rng)) * direction);
+		DetectionSettings s = settings(d0);
+		s.lengthTolerance = 1e-8 * 3;
+		const double brute = bruteForceSeparation(a, b);
+		const std::optional<PairContacts> r = detect(a, b, s);
+		SCOPED_TRACE("trial " + std::to_string(trial) + " brute separation " + std::to_string(brute));
+		if (brute > d0 + s.lengthTolerance) {
+			EXPECT_FALSE(r.has_value());
+			++far;
+			continue;
+		}
+		if (brute < 0) EXPECT_TRUE(r.has_value());
+		if (!r) continue;  // within d0 by the separating axes, but the boxes' bounds are apart
+		++found;
+		SCOPED_TRACE(describe(*r));
+		checkInvariants(*r, a, b, s);
+		EXPECT_LE(r->separation, brute + 1e-9);
+		if (cornerInside(a, b, s.lengthTolerance) || cornerInside(b, a, s.lengthTolerance)) {
+			++overlapping;
+			EXPECT_TRUE(std::any_of(r->contacts.begin(), r->contacts.end(), [](const SubContact& c) { return c.gap < 0; }));
+		}
+	}
+	EXPECT_GT(found, 100);
+	EXPECT_GT(overlapping, 30);
+	EXPECT_GT(far, 10);
+}
+
+}  // namespace
