@@ -300,7 +300,8 @@ void faceEntranceContacts(const Prepared& owner, bool ownerIsA, int f, const Pre
 	for (int q : owner.shape->faces[f]) {
 		const Vector3& x = owner.corner(q);
 		bool coincident = false;  // with a corner used above
-		for (int v : used) coincident = coincident || (other.corner(v) - x).norm() <= settings.lengthTolerance;
+		const double merge = std::max(settings.cornerMergeDistance, settings.lengthTolerance);
+		for (int v : used) coincident = coincident || (other.corner(v) - x).norm() <= merge;
 		if (coincident) continue;
 		int bestFace = -1;
 		double bestDistance = -std::numeric_limits<double>::infinity();

@@ -37,8 +37,10 @@
 //          through F);
 //        - vertex-face G <- Q for each corner Q of F within d0 of I, G the
 //          face of I of largest signed distance of Q (Q's own entrance face),
-//          Q's projection in G widened by d0, and Q not within lengthTolerance
-//          of a corner P already used (coincident corners give one contact);
+//          Q's projection in G widened by d0, and Q not within
+//          cornerMergeDistance of a corner P already used (corners that
+//          coincide, to round-off or to the small strains of the blocks
+//          since they met, give one contact, not two opposed ones);
 //        - edge-edge for each edge of I crossing an edge of F with both
 //          closest points more than lengthTolerance inside the segments (a
 //          crossing at an endpoint is a vertex contact), non-parallel, its
@@ -116,6 +118,11 @@ struct DetectionSettings {
 	// this of the best axis [m] (rule: 0.1 x d0; lengthTolerance is used when
 	// smaller).
 	double hysteresis = 0;
+	// Two corners of the two blocks closer than this [m] are one contact
+	// point (rule: 1e-3 x the smaller block's bounding-box diagonal, far above
+	// the strain-driven drift of corners that started coincident, far below
+	// the block's own features); lengthTolerance is used when larger.
+	double cornerMergeDistance = 0;
 };
 
 // One vertex-face or edge-edge sub-contact. Blocks are called A and B (the

@@ -22,6 +22,9 @@ constexpr int kMinBlocksForThreads = 64;
 // that a contact keeps its entrance face; stops the normal flipping between
 // nearly equal faces from step to step).
 constexpr double kEntranceHysteresis = 0.1;
+// Corners of two blocks closer than this fraction of the smaller block's
+// diagonal make one contact point (DetectionSettings::cornerMergeDistance).
+constexpr double kCornerMergeFraction = 1e-3;
 double secondsSince(Clock::time_point start) {
 	return std::chrono::duration<double>(Clock::now() - start).count();
 }
@@ -177,6 +180,7 @@ void World::detectContacts(const IntegratorSettings& settings, StepStatistics& s
 		detection.contactDistance = stats.contactDistance;
 		detection.lengthTolerance = kDefaultRelativeLengthTolerance * std::max(diagonal[a], diagonal[b]);
 		detection.hysteresis = std::max(kEntranceHysteresis * stats.contactDistance, detection.lengthTolerance);
+		detection.cornerMergeDistance = kCornerMergeFraction * std::min(diagonal[a], diagonal[b]);
 		pairResults_[p] = detectPairContacts(BlockGeometry{A.shape.get(), &A.vertices, A.centroid},
 		                                     BlockGeometry{B.shape.get(), &B.vertices, B.centroid}, detection,
 		                                     store_.previousEntrance(a, b));
