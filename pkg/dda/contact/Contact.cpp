@@ -83,10 +83,26 @@ Contact& ContactStore::add(const ContactKey& key, ContactType pairType, const Su
 			}
 		}
 	}
+	bool swapped = false;
+	if (predecessor < 0 && key.kind == ContactKind::EdgeEdge) {
+		// The same two edges with the roles of i and j exchanged (the pair's
+		// entrance moved from a face of one block to the crossing edges, or back).
+		const auto reversed = previousIndex_.find(ContactKey{key.blockJ, key.blockI, key.kind, key.feature2, key.feature1});
+		if (reversed != previousIndex_.end() && !claimed_[reversed->second]) {
+			predecessor = reversed->second;
+			swapped = true;
+		}
+	}
 	if (predecessor >= 0) {
 		claimed_[predecessor] = 1;
 		contact.history = previous_[predecessor].history;
 		contact.isNew = false;
+		if (swapped) {
+			ContactHistory& h = contact.history;
+			std::swap(h.anchorI, h.anchorJ);
+			h.slidingDirection = -h.slidingDirection;
+			h.shearForce = -h.shearForce;
+		}
 	}
 	current_.push_back(contact);
 	return current_.back();

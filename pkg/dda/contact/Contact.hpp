@@ -7,9 +7,11 @@
 // the second edge. The next step's sub-contact with the same identity takes
 // over its history. When a vertex slides from a face onto a neighbouring face
 // of the same block (or an edge-edge contact moves to an edge sharing a corner
-// with the old one) the identity changes; ContactStore::inherit then looks for
+// with the old one) the identity changes; ContactStore::add then looks for
 // that neighbour, so a sliding contact keeps sliding and a locked contact
-// keeps its shear spring.
+// keeps its shear spring. An edge-edge contact whose two edges come back with
+// the roles of i and j exchanged keeps its history too (anchors swapped,
+// directions reversed).
 #pragma once
 
 #include "PairDetection.hpp"
