@@ -101,7 +101,8 @@ class DDAIntegrator(wrapper.PyRunner):
     - ``contactPenaltyFactor`` [-]: normal contact stiffness [N/m] is this x
       the smaller E x size of the two blocks (default 40; Shi: 40-100 x E).
     - ``shearStiffnessRatio`` [-]: shear / normal contact stiffness (0.4).
-    - ``maxOpenCloseIterations``: solves per step before dt is cut (6).
+    - ``maxOpenCloseIterations``: solves per step before dt is cut (20;
+      Shi's 6 cuts dt too often in 3D stacks).
     - ``openCloseShrink`` [-]: dt factor for a step whose iteration did not
       converge (0.3).
     - ``openCloseTolerance`` [-]: a closed contact opens when its gap exceeds
@@ -139,7 +140,7 @@ class DDAIntegrator(wrapper.PyRunner):
                                       'contact normal stiffness / min(E x block size) [-]')
     shearStiffnessRatio = _Parameter(0.4, lambda v: _finite('shearStiffnessRatio', v, 0),
                                      'contact shear / normal stiffness [-]')
-    maxOpenCloseIterations = _Parameter(6, lambda v: int(_finite('maxOpenCloseIterations', v, 1)),
+    maxOpenCloseIterations = _Parameter(20, lambda v: int(_finite('maxOpenCloseIterations', v, 1)),
                                         'open-close iterations before dt is cut')
     openCloseShrink = _Parameter(0.3, lambda v: _finite('openCloseShrink', v, 0, 0.99, lowOpen=True),
                                  'dt factor when the open-close iteration does not converge [-]')

@@ -69,6 +69,7 @@ struct Contact {
 	double shearStiffness = 0;   // [N/m]
 	double frictionTangent = 0;  // tan(friction angle) [-]
 	bool isNew = true;           // no history was found
+	int frictionSwitches = 0;    // sliding <-> locked switches in this step's open-close iteration
 	// Block i's contact point at the end of the step [m] (for reports).
 	Vector3 point = Vector3::Zero();
 };
