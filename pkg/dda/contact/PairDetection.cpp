@@ -44,28 +44,90 @@ constexpr double kEdgePenetrationFactor = 2;
 // vertex-face contacts of its corners already hold the pair along the normal.
 constexpr double kEdgeNormalMinCosine = 0.5;
 
+// Performance. The narrow phase runs for every pair the broad phase reports,
+// so it avoids work whose result it does not need, without changing any
+// result: the bounding boxes are tested before any face plane is built, face
+// areas are computed only when a tie between faces needs them, edge data only
+// when every face axis passed, per-call buffers are reused per thread (no heap
+// allocation in the steady state), signs of triple products of unit normals
+// and exact collinearity are settled by a double-precision filter with a
+// proven round-off bound before falling back to CGAL's exact predicates, and a
+// sub-contact's gap comes from its stencil without the full linearisation.
+// Every double result is computed by the same expressions as before.
+
+// |C . (B x A)| computed in double for unit vectors A, B, C (normalized face
+// normals, components within 1 + 4 DBL_EPSILON of 1 in magnitude) is within
+// about 21 DBL_EPSILON (~5e-15) of the exact triple product of those doubles;
+// above this bound its sign is the exact sign (dimensionless).
+constexpr double kUnitTripleRoundoff = 1e-13;
+
+// A component a_j b_k - a_k b_j of a cross product computed in double is
+// within 4 DBL_EPSILON max|a_i| max|b_i| of its exact value (barring
+// underflow); above this factor the exact cross product is not zero.
+constexpr double kCrossRoundoffRelative = 1e-14;
+
 ExactPoint exactPoint(const Vector3& p) { return ExactPoint(p.x(), p.y(), p.z()); }
 ExactVector exactVector(const Vector3& v) { return ExactVector(v.x(), v.y(), v.z()); }
 
 // A face's plane: the chooseFaceCorners triangle (counter-clockwise seen from
-// outside), its unit normal, and the polygon's area.
+// outside), its unit normal, and the lengths of the triangle's sides at f0.
 struct FacePlane {
 	std::array<int, 3> corners{};
 	Vector3 normal = Vector3::UnitZ();
-	double area = 0;  // [m^2]
+	double side1 = 0, side2 = 0;  // |f1 - f0|, |f2 - f0| [m]
 };
+
+// An edge: its direction (end - start), its length, and the cross product of
+// the outward normals of its two faces (second x first), the great circle of
+// its Gauss-map arc.
+struct EdgeData {
+	Vector3 direction = Vector3::Zero();  // [m]
+	double length = 0;                    // [m]
+	Vector3 arc = Vector3::Zero();        // dimensionless
+};
+
+struct FaceCandidate {
+	EntranceFeature feature;
+	double separation = 0;
+};
+
+// Per-thread buffers reused between calls (detectPairContacts is not
+// re-entrant within one thread).
+struct Scratch {
+	std::vector<FacePlane> faces[2];
+	std::vector<double> areas[2];  // < 0 until computed
+	std::vector<char> planeReady[2];
+	std::vector<double> separations[2];  // face axes' separations
+	std::vector<char> separationReady[2];
+	std::vector<EdgeData> edges[2];
+	std::vector<FaceCandidate> candidates;
+	std::vector<double> cornerDistances;
+	std::vector<int> used, faceEdges;
+	std::vector<Vector3> pointsA, pointsB;
+};
+
+Scratch& scratch() {
+	thread_local Scratch s;
+	return s;
+}
 
 // A block with the per-call data the narrow phase needs.
 struct Prepared {
 	const ConvexPolyhedron* shape = nullptr;
 	const std::vector<Vector3>* vertices = nullptr;
 	Vector3 centroid = Vector3::Zero();
-	std::vector<FacePlane> faces;
+	FacePlane* faces = nullptr;
+	double* areas = nullptr;
+	char* planeReady = nullptr;
+	double* separations = nullptr;
+	char* separationReady = nullptr;
+	const EdgeData* edges = nullptr;
+	int faceTotal = 0;
 	Vector3 lower = Vector3::Zero(), upper = Vector3::Zero();  // bounding box [m]
 
 	const Vector3& corner(int v) const { return (*vertices)[v]; }
 	int cornerCount() const { return static_cast<int>(vertices->size()); }
-	int faceCount() const { return static_cast<int>(faces.size()); }
+	int faceCount() const { return faceTotal; }
 	int edgeCount() const { return static_cast<int>(shape->edges.size()); }
 	const Vector3& edgeStart(int e) const { return corner(shape->edges[e][0]); }
 	const Vector3& edgeEnd(int e) const { return corner(shape->edges[e][1]); }
@@ -74,9 +136,23 @@ struct Prepared {
 	Vector3 edgeOutward(int e) const {
 		return faces[shape->edgeFaces[e][0]].normal + faces[shape->edgeFaces[e][1]].normal;
 	}
+	// The polygon's area [m^2], from the fan about its first corner.
+	double area(int f) const {
+		double& a = areas[f];
+		if (a < 0) {
+			const std::vector<int>& face = shape->faces[f];
+			const std::vector<Vector3>& v = *vertices;
+			Vector3 vectorArea = Vector3::Zero();
+			for (std::size_t k = 1; k + 1 < face.size(); ++k)
+				vectorArea += (v[face[k]] - v[face[0]]).cross(v[face[k + 1]] - v[face[0]]);
+			a = 0.5 * vectorArea.norm();
+		}
+		return a;
+	}
 };
 
-Prepared prepare(const BlockGeometry& block) {
+// Step 0 data: the block and its bounding box.
+Prepared prepareBounds(const BlockGeometry& block) {
 	Prepared p;
 	p.shape = block.shape;
 	p.vertices = block.vertices;
@@ -87,21 +163,52 @@ Prepared prepare(const BlockGeometry& block) {
 		p.lower = p.lower.cwiseMin(x);
 		p.upper = p.upper.cwiseMax(x);
 	}
-	p.faces.reserve(block.shape->faces.size());
-	for (const std::vector<int>& face : block.shape->faces) {
-		FacePlane plane;
-		plane.corners = chooseFaceCorners(v, face);
-		const Vector3& f0 = v[plane.corners[0]];
-		const Vector3 cross = (v[plane.corners[1]] - f0).cross(v[plane.corners[2]] - f0);
-		plane.normal = cross.normalized();
-		// Polygon area from the fan about its first corner.
-		Vector3 vectorArea = Vector3::Zero();
-		for (std::size_t k = 1; k + 1 < face.size(); ++k)
-			vectorArea += (v[face[k]] - v[face[0]]).cross(v[face[k + 1]] - v[face[0]]);
-		plane.area = 0.5 * vectorArea.norm();
-		p.faces.push_back(plane);
-	}
 	return p;
+}
+
+// Face planes (into the thread's buffer `slot`), each built when first needed
+// (ensurePlane): a pair rejected by one face axis builds few of them.
+void prepareFaces(Prepared& p, Scratch& s, int slot) {
+	const std::size_t count = p.shape->faces.size();
+	s.faces[slot].resize(count);
+	s.areas[slot].assign(count, -1.0);
+	s.planeReady[slot].assign(count, 0);
+	s.separations[slot].resize(count);
+	s.separationReady[slot].assign(count, 0);
+	p.faces = s.faces[slot].data();
+	p.areas = s.areas[slot].data();
+	p.planeReady = s.planeReady[slot].data();
+	p.separations = s.separations[slot].data();
+	p.separationReady = s.separationReady[slot].data();
+	p.faceTotal = static_cast<int>(count);
+}
+
+void ensurePlane(const Prepared& p, int f) {
+	if (p.planeReady[f]) return;
+	const std::vector<Vector3>& v = *p.vertices;
+	FacePlane& plane = p.faces[f];
+	plane.corners = chooseFaceCorners(v, p.shape->faces[f]);
+	const Vector3& f0 = v[plane.corners[0]];
+	const Vector3 cross = (v[plane.corners[1]] - f0).cross(v[plane.corners[2]] - f0);
+	plane.normal = cross.normalized();
+	plane.side1 = (v[plane.corners[1]] - f0).norm();
+	plane.side2 = (v[plane.corners[2]] - f0).norm();
+	p.planeReady[f] = 1;
+}
+
+// Edge data (after prepareFaces).
+void prepareEdges(Prepared& p, Scratch& s, int slot) {
+	std::vector<EdgeData>& edges = s.edges[slot];
+	const int count = p.edgeCount();
+	edges.resize(count);
+	for (int e = 0; e < count; ++e) {
+		EdgeData& d = edges[e];
+		d.direction = p.edgeEnd(e) - p.edgeStart(e);
+		d.length = d.direction.norm();
+		const auto& ef = p.shape->edgeFaces[e];
+		d.arc = p.faces[ef[1]].normal.cross(p.faces[ef[0]].normal);
+	}
+	p.edges = edges.data();
 }
 
 // Signed distance [m] of x from the plane of face f of `block`, > 0 outside.
@@ -111,11 +218,12 @@ Prepared prepare(const BlockGeometry& block) {
 double planeDistance(const Prepared& block, int f, const Vector3& x) {
 	const FacePlane& plane = block.faces[f];
 	const Vector3& f0 = block.corner(plane.corners[0]);
+	const Vector3 offset = x - f0;
+	const double d = plane.normal.dot(offset);
+	const double scale = offset.norm() + plane.side1 + plane.side2;
+	if (std::abs(d) > kRoundoffRelative * scale) return d;
 	const Vector3& f1 = block.corner(plane.corners[1]);
 	const Vector3& f2 = block.corner(plane.corners[2]);
-	const double d = plane.normal.dot(x - f0);
-	const double scale = (x - f0).norm() + (f1 - f0).norm() + (f2 - f0).norm();
-	if (std::abs(d) > kRoundoffRelative * scale) return d;
 	const CGAL::Orientation side = CGAL::orientation(exactPoint(f0), exactPoint(f1), exactPoint(f2), exactPoint(x));
 	if (side == CGAL::COPLANAR) return 0;
 	const bool outside = side == CGAL::POSITIVE;
@@ -141,30 +249,79 @@ double insideMargin(const Prepared& block, int f, const Vector3& x) {
 
 // Two edge directions are parallel: exactly (cross product of the double
 // vectors zero, decided by CGAL) or within the angle tolerance.
-bool parallelDirections(const Vector3& da, const Vector3& db, double angleTolerance) {
-	if (CGAL::collinear(ExactPoint(0, 0, 0), exactPoint(da), exactPoint(db))) return true;
-	return da.cross(db).norm() <= std::sin(angleTolerance) * da.norm() * db.norm();
+// sinTolerance = sin(angleTolerance); la = |da|, lb = |db|.
+bool parallelDirections(const Vector3& da, const Vector3& db, double la, double lb, double sinTolerance) {
+	const Vector3 cross = da.cross(db);
+	if (cross.norm() <= sinTolerance * la * lb) return true;
+	// Not within the angle: parallel only when exactly collinear. A component
+	// of the double cross product above its round-off bound proves it is not.
+	const double scale = da.cwiseAbs().maxCoeff() * db.cwiseAbs().maxCoeff();
+	if (scale > 1e-250 && scale < 1e250 && cross.cwiseAbs().maxCoeff() > kCrossRoundoffRelative * scale) return false;
+	return CGAL::collinear(ExactPoint(0, 0, 0), exactPoint(da), exactPoint(db));
 }
 
-// Do the Gauss-map arcs (a1, a2) and (c, d) cross (strictly)? Signs of triple
-// products decided exactly (Gregorius, "The separating axis test between
-// convex polyhedra", GDC 2013).
-bool arcsCross(const Vector3& a1, const Vector3& a2, const Vector3& c, const Vector3& d) {
-	const ExactVector A = exactVector(a1), B = exactVector(a2), C = exactVector(c), D = exactVector(d);
-	const int cba = static_cast<int>(CGAL::orientation(C, B, A));  // C . (B x A)
-	const int dba = static_cast<int>(CGAL::orientation(D, B, A));
-	const int adc = static_cast<int>(CGAL::orientation(A, D, C));  // A . (D x C)
-	const int bdc = static_cast<int>(CGAL::orientation(B, D, C));
-	return cba * dba < 0 && adc * bdc < 0 && cba * bdc > 0;
+bool parallelDirections(const Vector3& da, const Vector3& db, double sinTolerance) {
+	return parallelDirections(da, db, da.norm(), db.norm(), sinTolerance);
+}
+
+// Exact sign of the triple product x . (y x z) of three unit vectors, given
+// its double value `approx`.
+int unitOrientation(double approx, const Vector3& x, const Vector3& y, const Vector3& z) {
+	if (approx > kUnitTripleRoundoff) return 1;
+	if (approx < -kUnitTripleRoundoff) return -1;
+	return static_cast<int>(CGAL::orientation(exactVector(x), exactVector(y), exactVector(z)));
+}
+
+// Do the Gauss-map arcs of edge ea of A (a1, a2 its faces' normals) and of
+// edge eb of B (c, d: minus its faces' normals) cross (strictly)? Signs of
+// triple products decided exactly (Gregorius, "The separating axis test
+// between convex polyhedra", GDC 2013).
+bool arcsCross(const Prepared& a, int ea, const Prepared& b, int eb) {
+	const auto& fa = a.shape->edgeFaces[ea];
+	const auto& fb = b.shape->edgeFaces[eb];
+	const Vector3& A = a.faces[fa[0]].normal;
+	const Vector3& B = a.faces[fa[1]].normal;
+	const Vector3 C = -b.faces[fb[0]].normal, D = -b.faces[fb[1]].normal;
+	const Vector3& ba = a.edges[ea].arc;  // B x A
+	const Vector3& dc = b.edges[eb].arc;  // (-D) x (-C) = D x C
+	const int cba = unitOrientation(C.dot(ba), C, B, A);  // C . (B x A)
+	const int dba = unitOrientation(D.dot(ba), D, B, A);
+	if (!(cba * dba < 0)) return false;
+	const int adc = unitOrientation(A.dot(dc), A, D, C);  // A . (D x C)
+	const int bdc = unitOrientation(B.dot(dc), B, D, C);
+	return adc * bdc < 0 && cba * bdc > 0;
 }
 
 // Separation [m] along the outward normal of face f of `owner`: the smallest
-// signed distance of `other`'s corners from the face's plane.
+// signed distance of `other`'s corners from the face's plane (computed once).
 double faceSeparation(const Prepared& owner, int f, const Prepared& other) {
+	if (owner.separationReady[f]) return owner.separations[f];
+	ensurePlane(owner, f);
 	double separation = std::numeric_limits<double>::infinity();
 	for (int v = 0; v < other.cornerCount(); ++v)
 		separation = std::min(separation, planeDistance(owner, f, other.corner(v)));
+	owner.separations[f] = separation;
+	owner.separationReady[f] = 1;
 	return separation;
+}
+
+// The face of `owner` whose normal (from its first three corners) points
+// most along `direction`: the likeliest separating face axis, tried first.
+int likelySeparatingFace(const Prepared& owner, const Vector3& direction) {
+	const std::vector<Vector3>& v = *owner.vertices;
+	int best = -1;
+	double bestScore = -std::numeric_limits<double>::infinity();
+	for (int f = 0; f < owner.faceCount(); ++f) {
+		const std::vector<int>& face = owner.shape->faces[f];
+		const Vector3& f0 = v[face[0]];
+		const Vector3 n = (v[face[1]] - f0).cross(v[face[2]] - f0);
+		const double score = n.dot(direction) / n.norm();
+		if (score > bestScore) {
+			bestScore = score;
+			best = f;
+		}
+	}
+	return best;
 }
 
 struct EdgeAxis {
@@ -175,23 +332,23 @@ struct EdgeAxis {
 
 // Edge axis of edge ea of A and eb of B when the two edges form a face of the
 // Minkowski difference and are not parallel.
-EdgeAxis edgeAxis(const Prepared& a, int ea, const Prepared& b, int eb, double angleTolerance) {
+EdgeAxis edgeAxis(const Prepared& a, int ea, const Prepared& b, int eb, double sinTolerance) {
 	EdgeAxis axis;
+	if (!arcsCross(a, ea, b, eb)) return axis;
+	const EdgeData& ed = a.edges[ea];
+	const EdgeData& fd = b.edges[eb];
+	const Vector3& da = ed.direction;
+	const Vector3& db = fd.direction;
+	if (parallelDirections(da, db, ed.length, fd.length, sinTolerance)) return axis;
 	const Vector3& a0 = a.edgeStart(ea);
 	const Vector3& a1 = a.edgeEnd(ea);
 	const Vector3& b0 = b.edgeStart(eb);
 	const Vector3& b1 = b.edgeEnd(eb);
-	const Vector3 da = a1 - a0, db = b1 - b0;
-	if (parallelDirections(da, db, angleTolerance)) return axis;
-	const auto& fa = a.shape->edgeFaces[ea];
-	const auto& fb = b.shape->edgeFaces[eb];
-	if (!arcsCross(a.faces[fa[0]].normal, a.faces[fa[1]].normal, -b.faces[fb[0]].normal,
-	               -b.faces[fb[1]].normal))
-		return axis;
 	Vector3 n = da.cross(db).normalized();
 	if (n.dot(a0 - a.centroid) < 0) n = -n;
-	double separation = n.dot(b0 - a0);
-	const double scale = (b0 - a0).norm() + da.norm() + db.norm();
+	const Vector3 offset = b0 - a0;
+	double separation = n.dot(offset);
+	const double scale = offset.norm() + ed.length + fd.length;
 	if (std::abs(separation) <= kRoundoffRelative * scale &&
 	    CGAL::orientation(exactPoint(a0), exactPoint(a1), exactPoint(b0), exactPoint(b1)) == CGAL::COPLANAR)
 		separation = 0;
@@ -201,30 +358,39 @@ EdgeAxis edgeAxis(const Prepared& a, int ea, const Prepared& b, int eb, double a
 	return axis;
 }
 
-struct FaceCandidate {
-	EntranceFeature feature;
-	double separation = 0;
-	double area = 0;
-};
-
 // The entrance face among the face axes: largest separation; within
 // lengthTolerance of it, the previous entrance face if it is one of them, else
 // the larger area, then A before B, then the lower face index (the order of
 // `faces`).
-const FaceCandidate& chooseFace(const std::vector<FaceCandidate>& faces, double lengthTolerance,
-                                const EntranceFeature& previous) {
+const FaceCandidate& chooseFace(const std::vector<FaceCandidate>& faces, const Prepared& a, const Prepared& b,
+                                double lengthTolerance, const EntranceFeature& previous) {
 	double best = -std::numeric_limits<double>::infinity();
 	for (const FaceCandidate& c : faces) best = std::max(best, c.separation);
 	const FaceCandidate* chosen = nullptr;
+	double chosenArea = 0;
 	for (const FaceCandidate& c : faces) {
 		if (c.separation < best - lengthTolerance) continue;
 		if (c.feature == previous) return c;
-		if (!chosen || c.area > chosen->area * (1 + kAreaTieRelative)) chosen = &c;
+		const double area = (c.feature.kind == EntranceFeature::FaceOfA ? a : b).area(c.feature.feature);
+		if (!chosen || area > chosenArea * (1 + kAreaTieRelative)) {
+			chosen = &c;
+			chosenArea = area;
+		}
 	}
 	return *chosen;
 }
 
 // ------------------------------------------------------------ sub-contacts
+
+// The stencil's start-of-step normal distance, as linearizeNormalDistance's
+// d0 (0 and invalid when S is not positive and finite).
+double stencilGap(const ContactStencil& stencil, bool& valid) {
+	const double area = stencilArea(stencil.kind, stencil.points);
+	const double delta = stencilDeterminant(stencil.points);
+	valid = area > 0 && std::isfinite(area);
+	if (!valid) return 0;
+	return stencil.sigma * delta / area;
+}
 
 SubContact vertexFaceContact(bool firstIsA, const Prepared& blockI, int vertex, const Prepared& blockJ, int face) {
 	SubContact c;
@@ -236,43 +402,57 @@ SubContact vertexFaceContact(bool firstIsA, const Prepared& blockI, int vertex, 
 	const Vector3& p = blockI.corner(vertex);
 	c.stencil = vertexFaceStencil(p, blockJ.corner(plane.corners[0]), blockJ.corner(plane.corners[1]),
 	                              blockJ.corner(plane.corners[2]));
-	c.gap = linearizeNormalDistance(c.stencil, blockI.centroid, blockJ.centroid).d0;
+	bool valid = false;
+	c.gap = stencilGap(c.stencil, valid);
 	c.normal = plane.normal;
 	c.pointI = p;
 	c.pointJ = p - c.gap * plane.normal;
 	return c;
 }
 
+// Gap and normal bounds a caller will require of an edge-edge sub-contact;
+// checking them before the closest points saves work, not results.
+struct EdgeContactLimits {
+	double highestGap = std::numeric_limits<double>::infinity();   // [m]
+	double deepestGap = -std::numeric_limits<double>::infinity();  // [m]
+	const Vector3* direction = nullptr;  // normal . direction >= minCosine when set
+	double minCosine = 0;
+};
+
 // Edge-edge sub-contact of edge e1 of block i and e2 of block j, or nothing
 // when the edges are parallel or their closest points are not strictly inside
-// both segments (more than lengthTolerance from every endpoint).
+// both segments (more than lengthTolerance from every endpoint), or it fails
+// `limits`.
 std::optional<SubContact> edgeEdgeContact(bool firstIsA, const Prepared& blockI, int e1, const Prepared& blockJ,
-                                          int e2, const DetectionSettings& settings) {
+                                          int e2, const DetectionSettings& settings, double sinTolerance,
+                                          const EdgeContactLimits& limits = {}) {
 	const Vector3& p1 = blockI.edgeStart(e1);
 	const Vector3& p2 = blockI.edgeEnd(e1);
 	const Vector3& p3 = blockJ.edgeStart(e2);
 	const Vector3& p4 = blockJ.edgeEnd(e2);
 	const Vector3 da = p2 - p1, db = p4 - p3;
-	if (parallelDirections(da, db, settings.angleTolerance)) return std::nullopt;
+	const double la = da.norm(), lb = db.norm();
+	if (parallelDirections(da, db, la, lb, sinTolerance)) return std::nullopt;
 	// From block i towards block j: out of i at its edge, into j at its edge.
 	const Vector3 reference = blockI.edgeOutward(e1) - blockJ.edgeOutward(e2);
+	SubContact c;
+	c.stencil = edgeEdgeStencil(p1, p2, p3, p4, reference);
+	bool valid = false;
+	c.gap = stencilGap(c.stencil, valid);
+	if (!valid) return std::nullopt;
+	if (c.gap > limits.highestGap || c.gap < limits.deepestGap) return std::nullopt;
+	// The stencil's n = -sigma (a x b)/|a x b| points from i to j.
+	c.normal = c.stencil.sigma * da.cross(db).normalized();
+	if (limits.direction && c.normal.dot(*limits.direction) < limits.minCosine) return std::nullopt;
 	const EdgeEdgeResult r =
 	    edgeEdgeDistance(p1, p2, p3, p4, reference, settings.lengthTolerance, settings.angleTolerance);
 	if (r.parallel || !r.interior) return std::nullopt;
 	const double tol = settings.lengthTolerance;
-	const double la = da.norm(), lb = db.norm();
 	if (r.s * la <= tol || (1 - r.s) * la <= tol || r.t * lb <= tol || (1 - r.t) * lb <= tol) return std::nullopt;
-	SubContact c;
 	c.kind = ContactKind::EdgeEdge;
 	c.firstIsA = firstIsA;
 	c.feature1 = e1;
 	c.feature2 = e2;
-	c.stencil = edgeEdgeStencil(p1, p2, p3, p4, reference);
-	const LinearizedDistance lin = linearizeNormalDistance(c.stencil, blockI.centroid, blockJ.centroid);
-	if (!lin.valid) return std::nullopt;
-	c.gap = lin.d0;
-	// The stencil's n = -sigma (a x b)/|a x b| points from i to j.
-	c.normal = c.stencil.sigma * da.cross(db).normalized();
 	c.pointI = r.closestI;
 	c.pointJ = r.closestJ;
 	return c;
@@ -281,27 +461,37 @@ std::optional<SubContact> edgeEdgeContact(bool firstIsA, const Prepared& blockI,
 // Step 3 for a face entrance: face f of block `owner` (block j of every
 // vertex-face contact of the other block's corners) entered by block `other`.
 void faceEntranceContacts(const Prepared& owner, bool ownerIsA, int f, const Prepared& other, double separation,
-                          const DetectionSettings& settings, std::vector<SubContact>& out) {
+                          const DetectionSettings& settings, double sinTolerance, Scratch& s,
+                          std::vector<SubContact>& out) {
 	// Within d0, to the length tolerance: a face is planar only to within it, so
 	// a corner touching a face may lie that far off the face's triangle plane.
 	const double reach = settings.contactDistance + settings.lengthTolerance;
 
 	// Corners of the other block on the face.
-	std::vector<int> used;
+	std::vector<double>& distance = s.cornerDistances;  // from the face's plane
+	distance.resize(other.cornerCount());
+	std::vector<int>& used = s.used;
+	used.clear();
 	for (int v = 0; v < other.cornerCount(); ++v) {
 		const Vector3& p = other.corner(v);
-		if (planeDistance(owner, f, p) > reach) continue;
+		distance[v] = planeDistance(owner, f, p);
+		if (distance[v] > reach) continue;
 		if (insideMargin(owner, f, p) < -reach) continue;
 		out.push_back(vertexFaceContact(!ownerIsA, other, v, owner, f));
 		used.push_back(v);
 	}
 
 	// Corners of the face near the other block, against their own entrance face.
+	const double merge = std::max(settings.cornerMergeDistance, settings.lengthTolerance);
 	for (int q : owner.shape->faces[f]) {
 		const Vector3& x = owner.corner(q);
 		bool coincident = false;  // with a corner used above
-		const double merge = std::max(settings.cornerMergeDistance, settings.lengthTolerance);
-		for (int v : used) coincident = coincident || (other.corner(v) - x).norm() <= merge;
+		for (int v : used) {
+			if ((other.corner(v) - x).norm() <= merge) {
+				coincident = true;
+				break;
+			}
+		}
 		if (coincident) continue;
 		int bestFace = -1;
 		double bestDistance = -std::numeric_limits<double>::infinity();
@@ -319,19 +509,25 @@ void faceEntranceContacts(const Prepared& owner, bool ownerIsA, int f, const Pre
 
 	// Edges of the other block crossing the face's edges.
 	const double deepest = kEdgePenetrationFactor * std::min(separation, 0.0) - reach;
-	std::vector<int> faceEdges;
+	std::vector<int>& faceEdges = s.faceEdges;
+	faceEdges.clear();
 	for (int e = 0; e < owner.edgeCount(); ++e) {
 		const auto& ef = owner.shape->edgeFaces[e];
 		if (ef[0] == f || ef[1] == f) faceEdges.push_back(e);
 	}
+	EdgeContactLimits limits;
+	limits.highestGap = reach;
+	limits.deepestGap = deepest;
+	limits.direction = &owner.faces[f].normal;
+	limits.minCosine = kEdgeNormalMinCosine;
+	const auto& otherEdges = other.shape->edges;
 	for (int e = 0; e < other.edgeCount(); ++e) {
-		const double low = std::min(planeDistance(owner, f, other.edgeStart(e)),
-		                            planeDistance(owner, f, other.edgeEnd(e)));
+		const double low = std::min(distance[otherEdges[e][0]], distance[otherEdges[e][1]]);
 		if (low > reach) continue;
 		for (int g : faceEdges) {
-			std::optional<SubContact> c = edgeEdgeContact(!ownerIsA, other, e, owner, g, settings);
-			if (!c || c->gap > reach || c->gap < deepest) continue;
-			if (c->normal.dot(owner.faces[f].normal) < kEdgeNormalMinCosine) continue;
+			std::optional<SubContact> c =
+			    edgeEdgeContact(!ownerIsA, other, e, owner, g, settings, sinTolerance, limits);
+			if (!c) continue;
 			if (planeDistance(owner, f, c->pointI) > reach) continue;  // crosses far from the face
 			out.push_back(*c);
 		}
@@ -381,7 +577,7 @@ Feature featureOf(const Prepared& block, const std::vector<Vector3>& points, dou
 }
 
 ContactType structuralType(const Prepared& a, const Feature& fa, const Prepared& b, const Feature& fb,
-                           double angleTolerance) {
+                           double sinTolerance) {
 	const FeatureKind ka = fa.kind, kb = fb.kind;
 	auto either = [&](FeatureKind x, FeatureKind y) { return (ka == x && kb == y) || (ka == y && kb == x); };
 	if (either(FeatureKind::Vertex, FeatureKind::Vertex)) return ContactType::VertexVertex;
@@ -391,18 +587,16 @@ ContactType structuralType(const Prepared& a, const Feature& fa, const Prepared&
 	if (either(FeatureKind::Face, FeatureKind::Face)) return ContactType::FaceFace;
 	const Vector3 da = a.edgeEnd(fa.index) - a.edgeStart(fa.index);
 	const Vector3 db = b.edgeEnd(fb.index) - b.edgeStart(fb.index);
-	return parallelDirections(da, db, angleTolerance) ? ContactType::EdgeEdgeParallel
-	                                                  : ContactType::EdgeEdgeCrossing;
+	return parallelDirections(da, db, sinTolerance) ? ContactType::EdgeEdgeParallel : ContactType::EdgeEdgeCrossing;
 }
 
 // Corners of `block` within `tolerance` of its extreme along `direction`.
-std::vector<Vector3> supportCorners(const Prepared& block, const Vector3& direction, double tolerance) {
+void supportCorners(const Prepared& block, const Vector3& direction, double tolerance, std::vector<Vector3>& out) {
 	double extreme = -std::numeric_limits<double>::infinity();
 	for (int v = 0; v < block.cornerCount(); ++v) extreme = std::max(extreme, direction.dot(block.corner(v)));
-	std::vector<Vector3> out;
+	out.clear();
 	for (int v = 0; v < block.cornerCount(); ++v)
 		if (direction.dot(block.corner(v)) >= extreme - tolerance) out.push_back(block.corner(v));
-	return out;
 }
 
 }  // namespace
@@ -425,34 +619,49 @@ std::optional<PairContacts> detectPairContacts(const BlockGeometry& blockA, cons
 	const double d0 = settings.contactDistance, tol = settings.lengthTolerance;
 
 	// Bounding boxes widened by d0.
-	const Prepared a = prepare(blockA);
-	const Prepared b = prepare(blockB);
+	Prepared a = prepareBounds(blockA);
+	Prepared b = prepareBounds(blockB);
 	for (int k = 0; k < 3; ++k) {
 		if (b.lower(k) > a.upper(k) + d0 || a.lower(k) > b.upper(k) + d0) return std::nullopt;
 	}
+	Scratch& s = scratch();
+	prepareFaces(a, s, 0);
+	prepareFaces(b, s, 1);
+	const double sinTolerance = std::sin(settings.angleTolerance);
 
-	// 1. Face axes, stopping at the first one farther than d0.
-	std::vector<FaceCandidate> faces;
-	faces.reserve(a.faces.size() + b.faces.size());
+	// 1. Face axes, stopping at the first one farther than d0. Any axis
+	// farther than d0 rejects the pair, so the likeliest separating face of
+	// each block (along the line of centroids) is tried first.
+	{
+		const Vector3 towardsB = b.centroid - a.centroid;
+		const int fa = likelySeparatingFace(a, towardsB);
+		if (fa >= 0 && faceSeparation(a, fa, b) > d0) return std::nullopt;
+		const int fb = likelySeparatingFace(b, -towardsB);
+		if (fb >= 0 && faceSeparation(b, fb, a) > d0) return std::nullopt;
+	}
+	std::vector<FaceCandidate>& faces = s.candidates;
+	faces.clear();
 	for (int f = 0; f < a.faceCount(); ++f) {
-		const double s = faceSeparation(a, f, b);
-		if (s > d0) return std::nullopt;
-		faces.push_back({{EntranceFeature::FaceOfA, f, -1}, s, a.faces[f].area});
+		const double sep = faceSeparation(a, f, b);
+		if (sep > d0) return std::nullopt;
+		faces.push_back({{EntranceFeature::FaceOfA, f, -1}, sep});
 	}
 	for (int f = 0; f < b.faceCount(); ++f) {
-		const double s = faceSeparation(b, f, a);
-		if (s > d0) return std::nullopt;
-		faces.push_back({{EntranceFeature::FaceOfB, f, -1}, s, b.faces[f].area});
+		const double sep = faceSeparation(b, f, a);
+		if (sep > d0) return std::nullopt;
+		faces.push_back({{EntranceFeature::FaceOfB, f, -1}, sep});
 	}
 	double bestFace = -std::numeric_limits<double>::infinity();
 	for (const FaceCandidate& c : faces) bestFace = std::max(bestFace, c.separation);
 
 	// Edge axes of the Minkowski difference's faces.
+	prepareEdges(a, s, 0);
+	prepareEdges(b, s, 1);
 	EdgeAxis bestEdge, previousEdge;
 	int bestEdgeA = -1, bestEdgeB = -1;
 	for (int ea = 0; ea < a.edgeCount(); ++ea) {
 		for (int eb = 0; eb < b.edgeCount(); ++eb) {
-			const EdgeAxis axis = edgeAxis(a, ea, b, eb, settings.angleTolerance);
+			const EdgeAxis axis = edgeAxis(a, ea, b, eb, sinTolerance);
 			if (!axis.valid) continue;
 			if (axis.separation > d0) return std::nullopt;
 			if (previous.kind == EntranceFeature::EdgePair && previous.feature == ea && previous.other == eb)
@@ -485,7 +694,7 @@ std::optional<PairContacts> detectPairContacts(const BlockGeometry& blockA, cons
 			entrance = {EntranceFeature::EdgePair, bestEdgeA, bestEdgeB};
 			separation = bestEdge.separation;
 		} else {
-			const FaceCandidate& c = chooseFace(faces, tol, previous);
+			const FaceCandidate& c = chooseFace(faces, a, b, tol, previous);
 			entrance = c.feature;
 			separation = c.separation;
 		}
@@ -493,40 +702,45 @@ std::optional<PairContacts> detectPairContacts(const BlockGeometry& blockA, cons
 
 	// 3. Sub-contacts.
 	PairContacts out;
+	out.contacts.reserve(8);
 	if (entrance.kind == EntranceFeature::EdgePair) {
-		std::optional<SubContact> c = edgeEdgeContact(true, a, entrance.feature, b, entrance.other, settings);
+		std::optional<SubContact> c =
+		    edgeEdgeContact(true, a, entrance.feature, b, entrance.other, settings, sinTolerance);
 		if (c) {
 			out.normal = (previousEdge.valid && entrance == previous) ? previousEdge.normal : bestEdge.normal;
 			out.contacts.push_back(*c);
 		} else {
-			const FaceCandidate& f = chooseFace(faces, tol, previous);
+			const FaceCandidate& f = chooseFace(faces, a, b, tol, previous);
 			entrance = f.feature;
 			separation = f.separation;
 		}
 	}
 	if (entrance.kind == EntranceFeature::FaceOfA) {
 		out.normal = a.faces[entrance.feature].normal;
-		faceEntranceContacts(a, true, entrance.feature, b, separation, settings, out.contacts);
+		faceEntranceContacts(a, true, entrance.feature, b, separation, settings, sinTolerance, s, out.contacts);
 	} else if (entrance.kind == EntranceFeature::FaceOfB) {
 		out.normal = -b.faces[entrance.feature].normal;
-		faceEntranceContacts(b, false, entrance.feature, a, separation, settings, out.contacts);
+		faceEntranceContacts(b, false, entrance.feature, a, separation, settings, sinTolerance, s, out.contacts);
 	}
 	out.entrance = entrance;
 	out.separation = separation;
 
 	// 4. Structural type from the contact points of the sub-contacts.
 	const double featureTolerance = d0 + tol;
-	std::vector<Vector3> pointsA, pointsB;
+	std::vector<Vector3>& pointsA = s.pointsA;
+	std::vector<Vector3>& pointsB = s.pointsB;
+	pointsA.clear();
+	pointsB.clear();
 	for (const SubContact& c : out.contacts) {
 		pointsA.push_back(c.firstIsA ? c.pointI : c.pointJ);
 		pointsB.push_back(c.firstIsA ? c.pointJ : c.pointI);
 	}
 	if (out.contacts.empty()) {
-		pointsA = supportCorners(a, out.normal, featureTolerance);
-		pointsB = supportCorners(b, -out.normal, featureTolerance);
+		supportCorners(a, out.normal, featureTolerance, pointsA);
+		supportCorners(b, -out.normal, featureTolerance, pointsB);
 	}
 	out.type = structuralType(a, featureOf(a, pointsA, featureTolerance), b, featureOf(b, pointsB, featureTolerance),
-	                          settings.angleTolerance);
+	                          sinTolerance);
 	return out;
 }
 
