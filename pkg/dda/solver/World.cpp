@@ -14,9 +14,13 @@ namespace dda {
 
 namespace {
 using Clock = std::chrono::steady_clock;
-// Per-block loops run in parallel only from this many blocks on: waking an
-// OpenMP team costs tens of microseconds, more than a few blocks' work.
-constexpr int kMinBlocksForThreads = 64;
+// Per-block loops run in parallel only from this many blocks (or pairs, or
+// components) on. Waking an OpenMP team costs tens of microseconds on idle
+// cores, and when another process holds a core each barrier can wait a whole
+// scheduler slice (milliseconds): a 100-block pile took 44 ms per step with 2
+// threads on a loaded 2-core machine, 0.5 ms with one. A block's own work is
+// about a microsecond, so below ~1000 blocks threads cannot pay.
+constexpr int kMinBlocksForThreads = 1024;
 // A pair keeps its entrance feature while that feature's separation stays
 // within this fraction of the contact distance of the best axis (Shi's rule
 // that a contact keeps its entrance face; stops the normal flipping between
