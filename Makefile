@@ -35,6 +35,7 @@ test: install
 
 bench: install
 	$(PYTHON) bench/free_blocks.py
+	$(PYTHON) bench/contacts.py
 
 clean:
 	rm -rf $(BUILD)
