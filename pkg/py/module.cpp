@@ -46,26 +46,28 @@ py::list toList(const std::vector<Vector3>& points) {
 }
 
 int addBlock(SceneLink& scene, const py::object& points, double density, double young, double poisson,
-             double frictionAngle, bool fixed) {
-	return scene.world.addBlock(toPoints(points, "block vertices"), Material{density, young, poisson, frictionAngle},
-	                            fixed);
+             double frictionAngle, double cohesion, double tensileStrength, bool fixed) {
+	return scene.world.addBlock(toPoints(points, "block vertices"),
+	                            Material{density, young, poisson, frictionAngle, cohesion, tensileStrength}, fixed);
 }
 
 // Validates a block without adding it (ddaBlock calls this before making a body).
-void checkBlock(const py::object& points, double density, double young, double poisson, double frictionAngle) {
-	validateMaterial(Material{density, young, poisson, frictionAngle});
+void checkBlock(const py::object& points, double density, double young, double poisson, double frictionAngle,
+                double cohesion, double tensileStrength) {
+	validateMaterial(Material{density, young, poisson, frictionAngle, cohesion, tensileStrength});
 	buildConvexPolyhedron(toPoints(points, "block vertices"));
 }
 
 // One tuple per sub-contact: (block i, block j, kind, structural type, state,
 // normal from j to i, point, normal force [N], shear force on i [N], gap at the
-// start of the step [m]).
+// start of the step [m], bonded).
 py::list contactList(const SceneLink& s) {
 	py::list out;
 	for (const Contact& c : s.world.contacts()) {
 		out.append(py::make_tuple(c.key.blockI, c.key.blockJ, c.key.kind == ContactKind::VertexFace ? "VF" : "EE",
 		                          contactTypeName(c.pairType), contactStateName(c.history.state), c.geometry.normal,
-		                          c.point, c.history.normalForce, c.history.shearForce, c.geometry.gap));
+		                          c.point, c.history.normalForce, c.history.shearForce, c.geometry.gap,
+		                          c.history.bonded));
 	}
 	return out;
 }
@@ -218,7 +220,8 @@ BOOST_PYTHON_MODULE(_core) {
 	py::docstring_options options(true, true, false);
 
 	py::def("checkBlock", &checkBlock,
-	        (py::arg("points"), py::arg("density"), py::arg("young"), py::arg("poisson"), py::arg("frictionAngle") = 0.0),
+	        (py::arg("points"), py::arg("density"), py::arg("young"), py::arg("poisson"), py::arg("frictionAngle") = 0.0,
+	         py::arg("cohesion") = 0.0, py::arg("tensileStrength") = 0.0),
 	        "Raises ValueError naming the problem if the points and material cannot make a DDA block.");
 
 	py::class_<IntegratorSettings>("IntegratorSettings", "Parameters of one DDA step (see DDAIntegrator for units and meaning).")
@@ -245,7 +248,7 @@ BOOST_PYTHON_MODULE(_core) {
 	py::class_<SceneLink, boost::noncopyable>("Scene", "The DDA state of one YADE scene; the core is the source of truth.")
 	    .def("addBlock", &addBlock,
 	         (py::arg("points"), py::arg("density"), py::arg("young"), py::arg("poisson"), py::arg("frictionAngle"),
-	          py::arg("fixed")))
+	          py::arg("cohesion"), py::arg("tensileStrength"), py::arg("fixed")))
 	    .def("contacts", &contactList)
 	    .def("setCollider", &setCollider)
 	    .def("collider", &colliderName)

@@ -9,7 +9,8 @@ from . import scene as _scene
 class BlockSpec:
     """What the core needs to build a block once its body is in O.bodies."""
 
-    __slots__ = ('points', 'density', 'young', 'poisson', 'frictionAngle', 'fixed', 'fixedPoints', 'loads', 'stress')
+    __slots__ = ('points', 'density', 'young', 'poisson', 'frictionAngle', 'cohesion', 'tensileStrength', 'fixed',
+                 'fixedPoints', 'loads', 'stress')
 
     def __init__(self, **kw):
         for key in self.__slots__:
@@ -27,6 +28,16 @@ def _vector(value, what, length=3):
         if not math.isfinite(x):
             raise ValueError('%s has a non-finite component %d: %r' % (what, i, x))
     return tuple(values)
+
+
+def _finiteNonNegative(value, what, unit):
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        raise TypeError('%s must be a number [%s], got %r' % (what, unit, value)) from None
+    if not (math.isfinite(value) and value >= 0):
+        raise ValueError('%s must be finite and >= 0 %s, got %r' % (what, unit, value))
+    return value
 
 
 def _points(vertices):
@@ -77,7 +88,8 @@ def _elasticConstants(material):
 
 
 def ddaBlock(vertices, material=None, fixed=False, color=None, velocity=(0, 0, 0),
-             angularVelocity=(0, 0, 0), fixedPoints=(), loads=(), stress=None, mask=1, wire=False):
+             angularVelocity=(0, 0, 0), fixedPoints=(), loads=(), stress=None, mask=1, wire=False,
+             cohesion=0.0, tensileStrength=0.0):
     """A DDA block as a YADE Body, ready for ``O.bodies.append``.
 
     The block is the convex polyhedron whose corners are ``vertices`` [m]
@@ -103,6 +115,12 @@ def ddaBlock(vertices, material=None, fixed=False, color=None, velocity=(0, 0, 0
     :param loads: ``(point, force)`` pairs: constant forces [N] at material points [m].
     :param stress: initial stress (sxx, syy, szz, sxy, syz, szx) [Pa].
     :param mask: YADE groupMask of the body.
+    :param cohesion: joint cohesion [Pa] of the block's contacts that are
+        closed when the scene starts (bonded joints); a contact takes the
+        smaller value of its two blocks and its share of the pair's contact
+        area. A bond breaks for good when shear exceeds friction plus
+        cohesion x area, or tension exceeds tensileStrength x area.
+    :param tensileStrength: joint tensile strength [Pa] of bonded joints.
 
     Raises ValueError naming the problem for bad geometry (fewer than 4 points,
     coplanar, duplicated, NaN/inf, a point that is not a corner of the hull),
@@ -116,7 +134,9 @@ def ddaBlock(vertices, material=None, fixed=False, color=None, velocity=(0, 0, 0
     points = _points(vertices)
     mat = _material(material)
     density, young, poisson, frictionAngle = _elasticConstants(mat)
-    _core.checkBlock(points, density, young, poisson, frictionAngle)
+    cohesion = _finiteNonNegative(cohesion, 'cohesion', 'Pa')
+    tensileStrength = _finiteNonNegative(tensileStrength, 'tensileStrength', 'Pa')
+    _core.checkBlock(points, density, young, poisson, frictionAngle, cohesion, tensileStrength)
     velocity = _vector(velocity, 'velocity')
     angularVelocity = _vector(angularVelocity, 'angularVelocity')
     if fixed and (any(velocity) or any(angularVelocity)):
@@ -143,7 +163,7 @@ def ddaBlock(vertices, material=None, fixed=False, color=None, velocity=(0, 0, 0
         body.state.vel = velocity
         body.state.angVel = angularVelocity
     spec = BlockSpec(points=points, density=density, young=young, poisson=poisson, frictionAngle=frictionAngle,
-                     fixed=bool(fixed),
+                     cohesion=cohesion, tensileStrength=tensileStrength, fixed=bool(fixed),
                      fixedPoints=fixedList, loads=loadList, stress=stress)
     _scene.current().register(body, spec)
     return body

@@ -46,7 +46,7 @@ class DDAScene:
                 waiting.append((body, spec))   # made but not (yet) appended: not simulated
                 continue
             index = self.core.addBlock(spec.points, spec.density, spec.young, spec.poisson, spec.frictionAngle,
-                                       spec.fixed)
+                                       spec.cohesion, spec.tensileStrength, spec.fixed)
             self.core.linkBody(index, body.id, body.state.ori, list(body.shape.v))
             # The body's state is read here, so a script may still set
             # b.state.vel / b.state.angVel between ddaBlock() and the first step.
@@ -209,10 +209,13 @@ class ContactView:
     towards id1. ``point`` [m]: the contact point on id1. ``normalForce`` [N]:
     compressive normal force (>= 0). ``shearForce`` [N]: tangential force on
     id1 (shear spring when locked, friction when sliding). ``gap`` [m]: normal
-    distance at the start of the step (< 0 penetrating).
+    distance at the start of the step (< 0 penetrating). ``bonded``: an
+    intact bonded joint (see ddaBlock's cohesion); its normalForce may be
+    negative (tension).
     """
 
-    __slots__ = ('id1', 'id2', 'kind', 'type', 'state', 'normal', 'point', 'normalForce', 'shearForce', 'gap')
+    __slots__ = ('id1', 'id2', 'kind', 'type', 'state', 'normal', 'point', 'normalForce', 'shearForce', 'gap',
+                 'bonded')
 
     def __init__(self, *values):
         for name, value in zip(self.__slots__, values):
@@ -242,10 +245,10 @@ def contacts(state=None):
         raise ValueError("state must be None, 'open', 'sliding', 'locked' or 'closed', got %r" % (state,))
     bodyOf = scene.bodyOfBlock
     out = []
-    for i, j, kind, ctype, cstate, normal, point, fn, fs, gap in scene.core.contacts():
+    for i, j, kind, ctype, cstate, normal, point, fn, fs, gap, bonded in scene.core.contacts():
         if state is not None and cstate != state and not (state == 'closed' and cstate != 'open'):
             continue
-        out.append(ContactView(bodyOf[i], bodyOf[j], kind, ctype, cstate, normal, point, fn, fs, gap))
+        out.append(ContactView(bodyOf[i], bodyOf[j], kind, ctype, cstate, normal, point, fn, fs, gap, bonded))
     return out
 
 

@@ -170,7 +170,7 @@ TEST(ContactMechanics, FrictionlessContactsSlideAndCarryNoFrictionTerms) {
 	EXPECT_EQ(c.frictionTangent, 0.0);  // the smaller friction angle of the two blocks
 	c.isNew = true;
 	c.normal.d0 = -1e-6;  // already penetrating: starts closed
-	startTrial(c);
+	startTrial(c, false);
 	EXPECT_EQ(c.trial.state, ContactState::Sliding);
 	Matrix24 K;
 	Vector24 F;

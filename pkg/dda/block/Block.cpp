@@ -15,6 +15,10 @@ void validateMaterial(const Material& material) {
 		message << "Poisson's ratio must lie in (-1, 0.5), got " << material.poisson;
 	else if (!(std::isfinite(material.frictionAngle) && material.frictionAngle >= 0 && material.frictionAngle < M_PI / 2))
 		message << "friction angle must lie in [0, pi/2) rad, got " << material.frictionAngle << " rad";
+	else if (!(std::isfinite(material.cohesion) && material.cohesion >= 0))
+		message << "cohesion must be >= 0 and finite, got " << material.cohesion << " Pa";
+	else if (!(std::isfinite(material.tensileStrength) && material.tensileStrength >= 0))
+		message << "tensile strength must be >= 0 and finite, got " << material.tensileStrength << " Pa";
 	else
 		return;
 	throw InputError(message.str());

@@ -21,6 +21,11 @@ struct Material {
 	double young = 1e9;        // Pa, > 0
 	double poisson = 0.25;     // -, in (-1, 0.5)
 	double frictionAngle = 0;  // rad, in [0, pi/2); 0 = frictionless joints
+	// Joint bond strengths [Pa], >= 0: contacts closed when the scene starts
+	// are bonded joints that resist shear up to cohesion x area beyond
+	// friction and tension up to tensileStrength x area, until they break.
+	double cohesion = 0;
+	double tensileStrength = 0;
 };
 
 // Throws InputError naming the offending value.

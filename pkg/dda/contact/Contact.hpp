@@ -53,7 +53,10 @@ struct ContactHistory {
 	// Sliding: unit direction of block i's motion relative to block j, along
 	// which friction resists.
 	Vector3 slidingDirection = Vector3::Zero();
-	double normalForce = 0;  // [N], >= 0, compressive; feeds the next friction force
+	double normalForce = 0;  // [N], compressive > 0 (tension < 0 only while bonded); feeds friction
+	// A bonded joint (closed when the scene started, both blocks with bond
+	// strength) until tension or shear breaks it; a broken bond never heals.
+	bool bonded = false;
 	Vector3 shearForce = Vector3::Zero();  // force on block i in the tangent plane [N]
 };
 
@@ -68,6 +71,9 @@ struct Contact {
 	double normalStiffness = 0;  // [N/m]
 	double shearStiffness = 0;   // [N/m]
 	double frictionTangent = 0;  // tan(friction angle) [-]
+	double area = 0;             // share of its pair's contact area [m^2]
+	double cohesionForce = 0;    // bond's shear strength beyond friction [N]
+	double tensileForce = 0;     // bond's tensile strength [N]
 	bool isNew = true;           // no history was found
 	int frictionSwitches = 0;    // sliding <-> locked switches in this step's open-close iteration
 	// Block i's contact point at the end of the step [m] (for reports).

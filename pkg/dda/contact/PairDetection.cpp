@@ -269,6 +269,13 @@ bool parallelDirections(const Vector3& da, const Vector3& db, double sinToleranc
 int unitOrientation(double approx, const Vector3& x, const Vector3& y, const Vector3& z) {
 	if (approx > kUnitTripleRoundoff) return 1;
 	if (approx < -kUnitTripleRoundoff) return -1;
+	// Exactly zero when each of the determinant's six terms x_i y_j z_k has a
+	// zero factor (axis-aligned normals).
+	bool zero = true;
+	for (const auto& [i, j, k] : {std::array<int, 3>{0, 1, 2}, std::array<int, 3>{1, 2, 0}, std::array<int, 3>{2, 0, 1},
+	                              std::array<int, 3>{0, 2, 1}, std::array<int, 3>{1, 0, 2}, std::array<int, 3>{2, 1, 0}})
+		zero = zero && (x[i] == 0 || y[j] == 0 || z[k] == 0);
+	if (zero) return 0;
 	return static_cast<int>(CGAL::orientation(exactVector(x), exactVector(y), exactVector(z)));
 }
 

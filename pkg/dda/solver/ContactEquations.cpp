@@ -26,10 +26,13 @@ Vector24 stacked(const Vector12& a, const Vector12& b) {
 
 bool closed(ContactState state) { return state != ContactState::Open; }
 
-// State a contact takes when it closes: locked, unless there is no friction to lock it.
+// Friction or an intact bond can hold a contact locked.
+bool canLock(const Contact& contact) { return contact.frictionTangent > 0 || contact.trial.bonded; }
+
+// State a contact takes when it closes: locked, unless nothing can lock it.
 void close(Contact& contact) {
 	ContactHistory& trial = contact.trial;
-	trial.state = contact.frictionTangent > 0 ? ContactState::Locked : ContactState::Sliding;
+	trial.state = canLock(contact) ? ContactState::Locked : ContactState::Sliding;
 	trial.anchorI = contact.geometry.pointI;
 	trial.anchorJ = contact.geometry.pointJ;
 	trial.slidingDirection.setZero();
@@ -43,15 +46,18 @@ void prepareContact(Contact& contact, const Block& blockI, const Block& blockJ, 
 	contact.normalStiffness = settings.contactPenaltyFactor * std::min(stiffnessI, stiffnessJ);
 	contact.shearStiffness = settings.shearStiffnessRatio * contact.normalStiffness;
 	contact.frictionTangent = std::tan(std::min(blockI.material.frictionAngle, blockJ.material.frictionAngle));
+	contact.cohesionForce = std::min(blockI.material.cohesion, blockJ.material.cohesion) * contact.area;
+	contact.tensileForce = std::min(blockI.material.tensileStrength, blockJ.material.tensileStrength) * contact.area;
 	contact.normal = linearizeNormalDistance(contact.geometry.stencil, blockI.centroid, blockJ.centroid);
 }
 
-void startTrial(Contact& contact) {
+void startTrial(Contact& contact, bool formBonds) {
 	if (!contact.isNew) {
 		contact.trial = contact.history;
 	} else {
 		contact.trial = ContactHistory();
 		if (contact.normal.valid && contact.normal.d0 <= 0) {
+			contact.trial.bonded = formBonds && (contact.cohesionForce > 0 || contact.tensileForce > 0);
 			close(contact);
 			contact.trial.normalForce = -contact.normalStiffness * contact.normal.d0;
 		}
@@ -79,7 +85,7 @@ bool contactTerms(const Contact& contact, const Block& blockI, const Block& bloc
 		const double ks = contact.shearStiffness;
 		stiffness.noalias() += ks * G.transpose() * P * G;
 		force.noalias() -= ks * G.transpose() * (P * (trial.anchorI - trial.anchorJ));
-	} else if (contact.frictionTangent > 0 && trial.normalForce > 0) {
+	} else if (contact.frictionTangent > 0 && trial.normalForce > 0) {  // sliding: never bonded
 		const Eigen::Matrix<double, 3, 24> H =
 		    relativeDisplacementMatrix(blockI, contact.geometry.pointI, blockJ, contact.geometry.pointJ);
 		force.noalias() -= H.transpose() * (contact.frictionTangent * trial.normalForce * trial.slidingDirection);
@@ -101,31 +107,39 @@ bool updateContactState(Contact& contact, const Block& blockI, const Block& bloc
 	if (!closed(before)) {
 		if (gap < 0) close(contact);
 	} else if (gap > openTolerance) {
-		trial.state = ContactState::Open;
+		// A bond holds in tension up to its strength; beyond, it breaks.
+		if (!(trial.bonded && contact.normalStiffness * gap <= contact.tensileForce)) {
+			trial.state = ContactState::Open;
+			trial.bonded = false;
+		}
 	}
 	if (!closed(trial.state)) {
 		trial.normalForce = 0;
 		return before != trial.state;
 	}
-	trial.normalForce = contact.normalStiffness * std::max(0.0, -gap);
-	if (contact.frictionTangent <= 0) {
+	trial.normalForce = -contact.normalStiffness * gap;
+	if (!trial.bonded) trial.normalForce = std::max(0.0, trial.normalForce);
+	if (!canLock(contact)) {
 		trial.state = ContactState::Sliding;
 		return before != trial.state;
 	}
 
-	// A closed contact without normal force (its gap inside the opening band)
-	// has no friction capacity to compare with: it keeps its state rather than
-	// flip on round-off of a vanishing shear.
-	if (trial.normalForce <= 0) return before != trial.state;
+	// An unbonded closed contact without normal force (its gap inside the
+	// opening band) has no friction capacity to compare with: it keeps its
+	// state rather than flip on round-off of a vanishing shear.
+	if (!trial.bonded && trial.normalForce <= 0) return before != trial.state;
 	const Matrix3 P = tangentProjector(n);
 	if (trial.state == ContactState::Locked) {
 		const Vector3 delta = (trial.anchorI + displacementAt(trial.anchorI - blockI.centroid, Di)) -
 		                      (trial.anchorJ + displacementAt(trial.anchorJ - blockJ.centroid, Dj));
 		const Vector3 shear = P * delta;
 		const double shearNorm = shear.norm();
-		if (contact.shearStiffness * shearNorm > contact.frictionTangent * trial.normalForce && shearNorm > 0) {
+		const double strength = contact.frictionTangent * std::max(0.0, trial.normalForce) +
+		                        (trial.bonded ? contact.cohesionForce : 0.0);
+		if (contact.shearStiffness * shearNorm > strength && shearNorm > 0) {
 			trial.state = ContactState::Sliding;
 			trial.slidingDirection = shear / shearNorm;
+			trial.bonded = false;
 		}
 	} else {
 		const Vector3 motion = displacementAt(contact.geometry.pointI - blockI.centroid, Di) -
@@ -150,7 +164,8 @@ void finishContact(Contact& contact, const Block& blockI, const Block& blockJ, c
 		return;
 	}
 	const double gap = contactGap(contact, Di, Dj);
-	trial.normalForce = contact.normalStiffness * std::max(0.0, -gap);
+	trial.normalForce = -contact.normalStiffness * gap;
+	if (!trial.bonded) trial.normalForce = std::max(0.0, trial.normalForce);
 	const Matrix3 P = tangentProjector(contact.geometry.normal);
 	if (trial.state == ContactState::Locked) {
 		const Vector3 delta = (trial.anchorI + displacementAt(trial.anchorI - blockI.centroid, Di)) -

@@ -30,6 +30,13 @@
 // A closed contact with zero normal force (gap within the opening band) keeps
 // its locked or sliding state. A frictionless contact that is closed is always
 // sliding, with no friction terms assembled at all.
+//
+// Bonded joints (cohesion c and tensile strength T of the materials, the
+// smaller of the two blocks; A the contact's share of its pair's contact
+// area): contacts closed when the scene starts are bonded. A bonded contact
+// stays closed in tension while kn d_n <= T A, and stays locked while
+// ks |P delta| <= tan(phi) max(N, 0) + c A; exceeding either breaks the bond
+// for good (then the rules above apply: no tension, pure Coulomb friction).
 #pragma once
 
 #include "IntegratorSettings.hpp"
@@ -65,8 +72,10 @@ double contactGap(const Contact& contact, const Vector12& Di, const Vector12& Dj
 void finishContact(Contact& contact, const Block& blockI, const Block& blockJ, const Vector12& Di, const Vector12& Dj);
 
 // A trial state for the start of a step's iteration: the history, or for a
-// new contact closed (locked, or sliding if frictionless) when it already
-// penetrates, open otherwise.
-void startTrial(Contact& contact);
+// new contact closed (locked, or sliding if nothing can lock it) when it
+// already touches or penetrates, open otherwise. With `formBonds` (the scene's
+// first step) a new closed contact between blocks with bond strength is a
+// bonded joint.
+void startTrial(Contact& contact, bool formBonds);
 
 }  // namespace dda

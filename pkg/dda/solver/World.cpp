@@ -52,6 +52,35 @@ bool crossesNearCorner(const SubContact& sub, double merge) {
 	return (sub.pointI - q[0]).norm() <= merge || (sub.pointI - q[1]).norm() <= merge ||
 	       (sub.pointJ - q[2]).norm() <= merge || (sub.pointJ - q[3]).norm() <= merge;
 }
+
+// Area [m^2] of the convex hull of the points projected on the plane
+// perpendicular to `normal` (Andrew's monotone chain, then the shoelace
+// formula); 0 for fewer than 3 points or collinear ones.
+double projectedHullArea(const std::vector<Vector3>& points, const Vector3& normal) {
+	if (points.size() < 3) return 0;
+	const Vector3 u = normal.unitOrthogonal(), v = normal.normalized().cross(u);
+	std::vector<std::pair<double, double>> p;
+	p.reserve(points.size());
+	for (const Vector3& x : points) p.emplace_back(u.dot(x - points[0]), v.dot(x - points[0]));
+	std::sort(p.begin(), p.end());
+	auto cross = [](const std::pair<double, double>& o, const std::pair<double, double>& a,
+	                const std::pair<double, double>& b) {
+		return (a.first - o.first) * (b.second - o.second) - (a.second - o.second) * (b.first - o.first);
+	};
+	std::vector<std::pair<double, double>> hull(2 * p.size());
+	std::size_t k = 0;
+	for (std::size_t i = 0; i < p.size(); ++i) {
+		while (k >= 2 && cross(hull[k - 2], hull[k - 1], p[i]) <= 0) --k;
+		hull[k++] = p[i];
+	}
+	for (std::size_t i = p.size() - 1, lower = k + 1; i-- > 0;) {
+		while (k >= lower && cross(hull[k - 2], hull[k - 1], p[i]) <= 0) --k;
+		hull[k++] = p[i];
+	}
+	double twice = 0;
+	for (std::size_t i = 0; i + 1 < k; ++i) twice += hull[i].first * hull[i + 1].second - hull[i + 1].first * hull[i].second;
+	return 0.5 * std::abs(twice);
+}
 }  // namespace
 
 int World::addBlock(const std::vector<Vector3>& points, const Material& material, bool fixed) {
@@ -216,11 +245,18 @@ void World::detectContacts(const IntegratorSettings& settings, StepStatistics& s
 		++stats.contactPairs;
 		store_.setEntrance(a, b, pair.entrance);
 		const double merge = kCornerMergeFraction * std::min(diagonal[a], diagonal[b]);
-		for (const SubContact& sub : pair.contacts) {
-			const int i = sub.firstIsA ? a : b, j = sub.firstIsA ? b : a;
-			if (sub.kind == ContactKind::EdgeEdge && crossesNearCorner(sub, merge)) continue;
-			const ContactKey key{i, j, sub.kind, sub.feature1, sub.feature2};
-			Contact& contact = store_.add(key, pair.type, sub, *blocks_[i].shape, *blocks_[j].shape);
+		accepted_.clear();
+		for (const SubContact& sub : pair.contacts)
+			if (!(sub.kind == ContactKind::EdgeEdge && crossesNearCorner(sub, merge))) accepted_.push_back(&sub);
+		// The pair's contact area, shared by its sub-contacts (bond strengths).
+		points_.clear();
+		for (const SubContact* sub : accepted_) points_.push_back(sub->pointJ);
+		const double area = accepted_.empty() ? 0.0 : projectedHullArea(points_, pair.normal) / accepted_.size();
+		for (const SubContact* sub : accepted_) {
+			const int i = sub->firstIsA ? a : b, j = sub->firstIsA ? b : a;
+			const ContactKey key{i, j, sub->kind, sub->feature1, sub->feature2};
+			Contact& contact = store_.add(key, pair.type, *sub, *blocks_[i].shape, *blocks_[j].shape);
+			contact.area = area;
 			prepareContact(contact, blocks_[i], blocks_[j], settings);
 		}
 	}
@@ -310,7 +346,7 @@ double World::step(const IntegratorSettings& settings) {
 		// Open-close iteration: solve with the trial contact states, update the
 		// states from the solution, until no state changes.
 		for (Contact& contact : contacts) {
-			startTrial(contact);
+			startTrial(contact, steps_ == 0);
 			contact.frictionSwitches = 0;
 		}
 		bool converged = false;

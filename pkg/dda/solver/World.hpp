@@ -60,6 +60,8 @@ private:
 	std::vector<int> movingIndex_;  // block -> index in moving_, -1 for fixed blocks
 	std::vector<const Block*> movingBlocks_;
 	std::vector<BlockMotion> motions_;
+	std::vector<const SubContact*> accepted_;
+	std::vector<Vector3> points_;
 	std::vector<Block> blocks_;
 	StepStatistics stats_;
 	double nextTimeStep_ = 0;  // dt to try first in the next step; 0 = maxTimeStep
