@@ -166,10 +166,12 @@ py::list syncData(SceneLink& s, bool all) {
 void setCollider(SceneLink& s, const std::string& name) {
 	if (name == "DESS")
 		s.world.setCollider(std::make_unique<DESSCollider>());
+	else if (name == "NBS")
+		s.world.setCollider(std::make_unique<NBSCollider>());
 	else if (name == "AllPairs")
 		s.world.setCollider(std::make_unique<AllPairsCollider>());
 	else
-		throw InputError("unknown collider '" + name + "' (known: DESS, AllPairs)");
+		throw InputError("unknown collider '" + name + "' (known: DESS, NBS, AllPairs)");
 }
 std::string colliderName(const SceneLink& s) { return s.world.collider().name(); }
 

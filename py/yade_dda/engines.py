@@ -48,7 +48,7 @@ class _Parameter:
         engine._updateCommand()
 
 
-_COLLIDERS = ('DESS', 'AllPairs')
+_COLLIDERS = ('DESS', 'NBS', 'AllPairs')
 
 
 def _colliderName(value):
@@ -108,8 +108,9 @@ class DDAIntegrator(wrapper.PyRunner):
     - ``openCloseTolerance`` [-]: a closed contact opens when its gap exceeds
       this x the allowed step displacement (1e-9).
     - ``collider``: the broad phase, ``'DESS'`` (one sorted box per block,
-      default) or ``'AllPairs'`` (every pair: the reference, O(n^2)). Both
-      give the same contacts; only the time differs.
+      default), ``'NBS'`` (one bounding sphere per block, binned in cells) or
+      ``'AllPairs'`` (every pair: the reference, O(n^2)). All give the same
+      contacts; only the time differs.
     - ``syncPeriod``: write the DDA state into YADE's bodies every n steps; 0
       (default) = when something may read it: the last step of ``O.run(n)``,
       ``O.step()``, a step after which another periodic engine (a PyRunner
@@ -145,7 +146,7 @@ class DDAIntegrator(wrapper.PyRunner):
     openCloseShrink = _Parameter(0.3, lambda v: _finite('openCloseShrink', v, 0, 0.99, lowOpen=True),
                                  'dt factor when the open-close iteration does not converge [-]')
     collider = _Parameter('DESS', lambda v: _colliderName(v),
-                          "broad phase: 'DESS' (sorted boxes, default) or 'AllPairs' (every pair, the oracle)")
+                          "broad phase: 'DESS' (sorted boxes, default), 'NBS' (binned spheres) or 'AllPairs' (every pair, the oracle)")
     openCloseTolerance = _Parameter(1e-9, lambda v: _finite('openCloseTolerance', v, 0),
                                     'opening gap of a closed contact / allowed step displacement [-]')
 

@@ -10,10 +10,19 @@
 
 #include <Eigen/Geometry>
 
+#include <array>
+#include <cstdint>
 #include <utility>
 #include <vector>
 
 namespace dda {
+
+// Bounding volumes are widened by this x the contact distance d0 on every
+// side, so two volumes meet whenever the blocks are within 2 d0. The narrow
+// phase accepts a corner within d0 of a face's plane whose projection falls
+// within d0 of the face, i.e. a corner up to sqrt(2) d0 from the other block:
+// half of d0 per side would miss those pairs (the collider test caught it).
+constexpr double kBroadPhaseMarginFactor = 1.0;
 
 struct BroadPhaseStatistics {
 	long candidatePairs = 0;  // block pairs handed to the narrow phase
@@ -39,10 +48,9 @@ public:
 };
 
 // Double-ended spatial sorting (Perkins & Williams): one axis-aligned box per
-// block, widened by half the contact distance on every side so that two boxes
-// overlap exactly when the blocks' boxes are within the contact distance on
-// all three axes; the box ends are sorted along the axis of largest spread
-// and swept, pairs overlapping there are checked on the other two axes.
+// block, widened by kBroadPhaseMarginFactor x d0 on every side; the box ends
+// are sorted along the axis of largest spread and swept, pairs overlapping
+// there are checked on the other two axes.
 // O(n log n + pairs) per step.
 class DESSCollider : public Collider {
 public:
@@ -53,6 +61,24 @@ public:
 private:
 	std::vector<Eigen::AlignedBox3d> boxes_;
 	std::vector<int> order_;
+};
+
+// No binary search (Munjiza & Andrews): one bounding sphere per block (centre
+// the box centre of its corners, radius to the farthest corner, plus
+// kBroadPhaseMarginFactor x d0); spheres are binned by centre into cubic cells as large
+// as the largest diameter, so overlapping spheres sit in the same or adjacent
+// cells, and only those are compared. O(n) for blocks of similar size; a few
+// large blocks make the cells coarse (the method's known weakness).
+class NBSCollider : public Collider {
+public:
+	const char* name() const override { return "NBS"; }
+	void findPairs(const std::vector<Block>& blocks, double contactDistance, std::vector<std::pair<int, int>>& pairs,
+	               BroadPhaseStatistics& stats) override;
+
+private:
+	std::vector<Vector3> centres_;
+	std::vector<double> radii_;
+	std::vector<std::pair<std::uint64_t, int>> cellOf_;  // (cell key, block), sorted
 };
 
 }  // namespace dda

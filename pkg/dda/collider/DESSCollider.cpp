@@ -10,7 +10,7 @@ void DESSCollider::findPairs(const std::vector<Block>& blocks, double contactDis
 	const int n = static_cast<int>(blocks.size());
 	boxes_.resize(n);
 	Eigen::AlignedBox3d all;
-	const Vector3 margin = Vector3::Constant(0.5 * contactDistance);
+	const Vector3 margin = Vector3::Constant(kBroadPhaseMarginFactor * contactDistance);
 	for (int b = 0; b < n; ++b) {
 		Eigen::AlignedBox3d box;
 		for (const Vector3& x : blocks[b].vertices) box.extend(x);

@@ -1,0 +1,133 @@
+// Broad phases against the all-pairs oracle: on random scenes of slender,
+// slanted, touching, fixed and free blocks, every collider proposes every pair
+// whose narrow phase finds a contact, so all of them end with exactly the
+// contact set of AllPairsCollider.
+#include "dda/collider/Collider.hpp"
+#include "dda/contact/PairDetection.hpp"
+#include "dda/solver/World.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include <memory>
+#include <random>
+#include <set>
+#include <tuple>
+
+using namespace dda;
+
+namespace {
+
+std::vector<Vector3> orientedBox(const Vector3& centre, const Vector3& half, const Eigen::Matrix3d& R) {
+	std::vector<Vector3> points;
+	for (int i = 0; i < 8; ++i) {
+		const Vector3 local((i & 1 ? 1 : -1) * half.x(), (i & 2 ? 1 : -1) * half.y(), (i & 4 ? 1 : -1) * half.z());
+		points.push_back(centre + R * local);
+	}
+	return points;
+}
+
+// n blocks: slender (up to 30:1, 15 m long) and compact boxes, randomly turned, packed so
+// that many touch or nearly touch; some fixed; a few exact corner-to-corner and
+// edge-to-edge placements.
+World randomScene(int n, unsigned seed) {
+	std::mt19937 rng(seed);
+	std::uniform_real_distribution<double> unit(0, 1);
+	World world;
+	Material material;
+	for (int k = 0; k < n; ++k) {
+		const double length = unit(rng) < 0.5 ? 1 + 14 * unit(rng) : 1 + unit(rng);
+		const Vector3 half(0.5 * length, 0.25 + 0.25 * unit(rng), 0.25 + 0.25 * unit(rng));
+		const Vector3 axis = Vector3(unit(rng) - 0.5, unit(rng) - 0.5, unit(rng) - 0.5).normalized();
+		const Eigen::Matrix3d R = Eigen::AngleAxisd(3.2 * unit(rng), axis).toRotationMatrix();
+		const Vector3 centre(25 * unit(rng), 25 * unit(rng), 25 * unit(rng));
+		world.addBlock(orientedBox(centre, half, R), material, unit(rng) < 0.3);
+	}
+	// Exact placements: unit cubes corner on corner and edge on edge.
+	const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+	world.addBlock(orientedBox(Vector3(30, 0, 0), Vector3(0.5, 0.5, 0.5), I), material, false);
+	world.addBlock(orientedBox(Vector3(31, 1, 1), Vector3(0.5, 0.5, 0.5), I), material, false);
+	world.addBlock(orientedBox(Vector3(30, 3, 0), Vector3(0.5, 0.5, 0.5), I), material, true);
+	world.addBlock(orientedBox(Vector3(31, 3, 1), Vector3(0.5, 0.5, 0.5), I), material, false);
+	return world;
+}
+
+std::vector<Block> blocksOf(const World& world) {
+	std::vector<Block> blocks;
+	for (int i = 0; i < world.blockCount(); ++i) blocks.push_back(world.block(i));
+	return blocks;
+}
+
+// The contact set: every sub-contact (pair, kind, owner, features) found.
+using ContactSet = std::set<std::tuple<int, int, int, bool, int, int>>;
+
+ContactSet contactSet(Collider& collider, const std::vector<Block>& blocks, double d0, long* candidates = nullptr) {
+	std::vector<std::pair<int, int>> pairs;
+	BroadPhaseStatistics stats;
+	collider.findPairs(blocks, d0, pairs, stats);
+	EXPECT_TRUE(std::is_sorted(pairs.begin(), pairs.end()));
+	if (candidates) *candidates = stats.candidatePairs;
+	ContactSet out;
+	for (auto [a, b] : pairs) {
+		EXPECT_LT(a, b);
+		EXPECT_FALSE(blocks[a].fixed && blocks[b].fixed);
+		DetectionSettings settings;
+		settings.contactDistance = d0;
+		settings.lengthTolerance = 1e-9;
+		const auto result = detectPairContacts(BlockGeometry{blocks[a].shape.get(), &blocks[a].vertices, blocks[a].centroid},
+		                                       BlockGeometry{blocks[b].shape.get(), &blocks[b].vertices, blocks[b].centroid},
+		                                       settings);
+		if (!result) continue;
+		for (const SubContact& c : result->contacts)
+			out.insert({a, b, static_cast<int>(c.kind), c.firstIsA, c.feature1, c.feature2});
+	}
+	return out;
+}
+
+}  // namespace
+
+TEST(Colliders, EveryStrategyFindsTheAllPairsContactSet) {
+	for (unsigned seed : {1u, 2u, 3u}) {
+		const std::vector<Block> blocks = blocksOf(randomScene(120, seed));
+		for (double d0 : {0.0, 0.05, 0.5}) {
+			AllPairsCollider all;
+			long allCandidates = 0;
+			const ContactSet reference = contactSet(all, blocks, d0, &allCandidates);
+			ASSERT_GT(reference.size(), 10u) << "the scene should have contacts";
+			DESSCollider dess;
+			NBSCollider nbs;
+			long dessCandidates = 0, nbsCandidates = 0;
+			EXPECT_TRUE(contactSet(dess, blocks, d0, &dessCandidates) == reference) << "seed " << seed << " d0 " << d0;
+			const ContactSet fromNbs = contactSet(nbs, blocks, d0, &nbsCandidates);
+			EXPECT_TRUE(fromNbs == reference) << "seed " << seed << " d0 " << d0;
+			for (const auto& c : reference)
+				if (!fromNbs.count(c)) ADD_FAILURE() << "NBS misses " << std::get<0>(c) << "-" << std::get<1>(c);
+			for (const auto& c : fromNbs)
+				if (!reference.count(c)) ADD_FAILURE() << "NBS adds " << std::get<0>(c) << "-" << std::get<1>(c);
+			// The point of a broad phase: fewer candidates than all pairs (NBS
+			// is poor with 15 m blocks among 1 m ones: its cells are 15 m wide).
+			EXPECT_LT(dessCandidates, allCandidates / 2);
+			EXPECT_LE(nbsCandidates, allCandidates);
+		}
+	}
+}
+
+TEST(Colliders, FixedPairsAreNeverProposed) {
+	World world;
+	Material material;
+	const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+	world.addBlock(orientedBox(Vector3(0, 0, 0), Vector3(0.5, 0.5, 0.5), I), material, true);
+	world.addBlock(orientedBox(Vector3(1, 0, 0), Vector3(0.5, 0.5, 0.5), I), material, true);
+	world.addBlock(orientedBox(Vector3(0, 1, 0), Vector3(0.5, 0.5, 0.5), I), material, false);
+	const std::vector<Block> blocks = blocksOf(world);
+	std::unique_ptr<Collider> colliders[] = {std::make_unique<AllPairsCollider>(), std::make_unique<DESSCollider>(),
+	                                         std::make_unique<NBSCollider>()};
+	for (auto& collider : colliders) {
+		std::vector<std::pair<int, int>> pairs;
+		BroadPhaseStatistics stats;
+		collider->findPairs(blocks, 0.1, pairs, stats);
+		const std::vector<std::pair<int, int>> expected{{0, 2}, {1, 2}};
+		EXPECT_EQ(pairs, expected) << collider->name();
+	}
+}
