@@ -163,6 +163,33 @@ py::list syncData(SceneLink& s, bool all) {
 	return out;
 }
 
+// The narrow phase of one pair of blocks at their current geometry, as the
+// integrator would see it with contact distance d0 [m]: None when farther
+// apart, else (structural type, entrance normal, [(kind, i owns, feature of
+// i, feature of j, gap, normal, point i, point j), ...]) with i, j block
+// indices of the sub-contact.
+py::object detectPair(const SceneLink& s, int a, int b, double d0) {
+	if (!(std::isfinite(d0) && d0 >= 0)) throw InputError("contact distance must be >= 0 and finite");
+	if (a == b) throw InputError("a block cannot contact itself");
+	const Block& A = s.world.block(a);
+	const Block& B = s.world.block(b);
+	Eigen::AlignedBox3d box;
+	for (const Vector3& x : A.vertices) box.extend(x);
+	for (const Vector3& x : B.vertices) box.extend(x);
+	DetectionSettings settings;
+	settings.contactDistance = d0;
+	settings.lengthTolerance = kDefaultRelativeLengthTolerance * box.diagonal().norm();
+	const auto result = detectPairContacts(BlockGeometry{A.shape.get(), &A.vertices, A.centroid},
+	                                       BlockGeometry{B.shape.get(), &B.vertices, B.centroid}, settings);
+	if (!result) return py::object();
+	py::list subs;
+	for (const SubContact& c : result->contacts) {
+		subs.append(py::make_tuple(c.kind == ContactKind::VertexFace ? "VF" : "EE", c.firstIsA ? a : b,
+		                           c.firstIsA ? b : a, c.feature1, c.feature2, c.gap, c.normal, c.pointI, c.pointJ));
+	}
+	return py::make_tuple(contactTypeName(result->type), result->normal, result->separation, subs);
+}
+
 void setCollider(SceneLink& s, const std::string& name) {
 	if (name == "DESS")
 		s.world.setCollider(std::make_unique<DESSCollider>());
@@ -253,6 +280,7 @@ BOOST_PYTHON_MODULE(_core) {
 	          py::arg("cohesion"), py::arg("tensileStrength"), py::arg("fixed")))
 	    .def("contacts", &contactList)
 	    .def("setCollider", &setCollider)
+	    .def("detectPair", &detectPair)
 	    .def("collider", &colliderName)
 	    .def("linkBody", &linkBody)
 	    .def("blockOfBody", &bodyToBlock)

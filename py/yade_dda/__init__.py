@@ -16,7 +16,7 @@ from ._yade import O
 from .blocks import ddaBlock
 from .engines import DDAIntegrator
 from .scene import (stats, sync, block, blockOf, setVelocity, addPointLoad, addFixedPoint,
-                    printStats, contacts)
+                    printStats, contacts, Ig2_DDABlock_DDABlock_DDAContact)
 
 __all__ = ['ddaBlock', 'DDAIntegrator', 'stats', 'printStats', 'sync', 'block', 'blockOf',
-           'setVelocity', 'addPointLoad', 'addFixedPoint', 'contacts', 'O']
+           'setVelocity', 'addPointLoad', 'addFixedPoint', 'contacts', 'Ig2_DDABlock_DDABlock_DDAContact', 'O']

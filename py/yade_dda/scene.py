@@ -252,6 +252,39 @@ def contacts(state=None):
     return out
 
 
+class Ig2_DDABlock_DDABlock_DDAContact:
+    """The pair functor of the DDA narrow phase (YADE's Ig2 naming), callable on
+    any two DDA blocks at their current geometry.
+
+    ``go(body1, body2, contactDistance)`` [m] returns None when the blocks are
+    farther apart than the contact distance, else a dict: ``type`` (structural
+    type of Wu et al.'s Table 1: 'VV', 'VE', 'VF', 'EE', 'EEp', 'EF', 'FF'),
+    ``normal`` (entrance normal, unit, from body1 towards body2),
+    ``separation`` [m] (along it; < 0 overlapping) and ``contacts``: the
+    vertex-face ('VF', the Ig2_Vertex_Face sub-functor) and edge-edge ('EE',
+    Ig2_Edge_Edge) sub-contacts, each a dict with ``kind``, ``id1``/``id2``
+    (id1 owns the vertex or first edge), ``feature1``/``feature2`` (vertex,
+    face or edge indices as in ``block(body).faces``/``.edges``), ``gap`` [m],
+    ``normal`` (from id2 towards id1), ``point1``/``point2`` [m].
+    The integrator runs the same functor every step. Example::
+
+        print(Ig2_DDABlock_DDABlock_DDAContact().go(b1, b2, 0.01))
+    """
+
+    def go(self, body1, body2, contactDistance=0.0):
+        scene = _require()
+        i, j = scene.blockIndex(body1), scene.blockIndex(body2)
+        result = scene.core.detectPair(i, j, float(contactDistance))
+        if result is None:
+            return None
+        ctype, normal, separation, subs = result
+        bodyOf = scene.bodyOfBlock
+        return dict(type=ctype, normal=normal, separation=separation,
+                    contacts=[dict(kind=kind, id1=bodyOf[bi], id2=bodyOf[bj], feature1=f1, feature2=f2, gap=gap,
+                                   normal=n, point1=p1, point2=p2)
+                              for kind, bi, bj, f1, f2, gap, n, p1, p2 in subs])
+
+
 def block(body):
     """The core state of a DDA body (a Body or its id) as a BlockView."""
     scene = _require()

@@ -104,3 +104,4 @@ def test_bond_strengths_are_validated(scene):
         ddaBlock(box((0, 0, 0), (1, 1, 1)), cohesion=-1)
     with pytest.raises(ValueError, match='tensileStrength'):
         ddaBlock(box((0, 0, 0), (1, 1, 1)), tensileStrength=float('nan'))
+
