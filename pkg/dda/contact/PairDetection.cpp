@@ -465,6 +465,16 @@ std::optional<SubContact> edgeEdgeContact(bool firstIsA, const Prepared& blockI,
 	return c;
 }
 
+// An edge-edge contact within `merge` [m] of the point of a vertex-face contact.
+bool besideVertexContact(const SubContact& crossing, const std::vector<SubContact>& found, double merge) {
+	for (const SubContact& other : found) {
+		if (other.kind != ContactKind::VertexFace) continue;
+		if ((other.pointI - crossing.pointI).norm() <= merge || (other.pointI - crossing.pointJ).norm() <= merge)
+			return true;
+	}
+	return false;
+}
+
 // Step 3 for a face entrance: face f of block `owner` (block j of every
 // vertex-face contact of the other block's corners) entered by block `other`.
 void faceEntranceContacts(const Prepared& owner, bool ownerIsA, int f, const Prepared& other, double separation,
@@ -522,6 +532,10 @@ void faceEntranceContacts(const Prepared& owner, bool ownerIsA, int f, const Pre
 		const auto& ef = owner.shape->edgeFaces[e];
 		if (ef[0] == f || ef[1] == f) faceEdges.push_back(e);
 	}
+	// A crossing beside a vertex contact found above is that corner's contact
+	// (two squares offset by a little drift cross each other's edges right
+	// beside their corners); a crossing with no vertex contact near it stays.
+	// (`merge` is the corner merge distance above.)
 	EdgeContactLimits limits;
 	limits.highestGap = reach;
 	limits.deepestGap = deepest;
@@ -536,6 +550,7 @@ void faceEntranceContacts(const Prepared& owner, bool ownerIsA, int f, const Pre
 			    edgeEdgeContact(!ownerIsA, other, e, owner, g, settings, sinTolerance, limits);
 			if (!c) continue;
 			if (planeDistance(owner, f, c->pointI) > reach) continue;  // crosses far from the face
+			if (besideVertexContact(*c, out, merge)) continue;
 			out.push_back(*c);
 		}
 	}

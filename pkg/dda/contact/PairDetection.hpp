@@ -48,7 +48,10 @@
 //          normal within 60 degrees of n and its gap no deeper than
 //          2 x (the entrance's penetration) + d0: an edge piercing F steeply
 //          near F's boundary has its line distance in F's plane and would
-//          push sideways by an unrelated depth.
+//          push sideways by an unrelated depth; and not within
+//          cornerMergeDistance of a vertex-face contact above (offset squares
+//          cross each other's edges right beside a corner that already has
+//          its contact; a crossing next to a corner with no contact stays).
 //      An edge entrance gives one edge-edge sub-contact (block i = A), or
 //      falls back to the best face when the two edges do not cross strictly
 //      inside. Edge-edge stencils take as reference direction (from block i

@@ -43,20 +43,6 @@ void requireFinite(const Vector3& v, const char* what) {
 		throw InputError(message.str());
 	}
 }
-// An edge-edge crossing within `merge` [m] of a vertex-face contact of the same
-// pair is that vertex contact, already represented (two squares offset by a
-// little drift cross each other's edges right beside their corners). Only a
-// crossing that has such a neighbour is dropped: a pair whose one contact is
-// a crossing next to a corner (a corner on an edge) keeps it.
-// TODO(detection): belongs in PairDetection's sub-contact rules.
-bool besideVertexContact(const SubContact& sub, const std::vector<SubContact>& all, double merge) {
-	for (const SubContact& other : all) {
-		if (other.kind != ContactKind::VertexFace) continue;
-		if ((other.pointI - sub.pointI).norm() <= merge || (other.pointI - sub.pointJ).norm() <= merge) return true;
-	}
-	return false;
-}
-
 // Area [m^2] of the convex hull of the points projected on the plane
 // perpendicular to `normal` (Andrew's monotone chain, then the shoelace
 // formula); 0 for fewer than 3 points or collinear ones.
@@ -248,11 +234,8 @@ void World::detectContacts(const IntegratorSettings& settings, StepStatistics& s
 		const PairContacts& pair = *pairResults_[p];
 		++stats.contactPairs;
 		store_.setEntrance(a, b, pair.entrance);
-		const double merge = kCornerMergeFraction * std::min(diagonal[a], diagonal[b]);
 		accepted_.clear();
-		for (const SubContact& sub : pair.contacts)
-			if (!(sub.kind == ContactKind::EdgeEdge && besideVertexContact(sub, pair.contacts, merge)))
-				accepted_.push_back(&sub);
+		for (const SubContact& sub : pair.contacts) accepted_.push_back(&sub);
 		// The pair's contact area, shared by its sub-contacts (bond strengths).
 		points_.clear();
 		for (const SubContact* sub : accepted_) points_.push_back(sub->pointJ);
