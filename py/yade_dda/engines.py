@@ -110,7 +110,8 @@ class DDAIntegrator(wrapper.PyRunner):
     - ``collider``: the broad phase, ``'DESS'`` (one sorted box per block,
       default), ``'NBS'`` (one bounding sphere per block, binned in cells) or
       ``'AllPairs'`` (every pair: the reference, O(n^2)). All give the same
-      contacts; only the time differs.
+      contacts; only the time differs. A collider engine before the
+      integrator (``DESSCollider``, ``NBSCollider``, ...) overrides it.
     - ``syncPeriod``: write the DDA state into YADE's bodies every n steps; 0
       (default) = when something may read it: the last step of ``O.run(n)``,
       ``O.step()``, a step after which another periodic engine (a PyRunner
@@ -277,8 +278,10 @@ def integratorStep(text):
     if len(scene.bodyOfBlock) != before or scene.checkedEngines != signature:
         _checkEngines(scene, engines)
         scene.checkedEngines = signature
-    if scene.core.collider() != params['collider']:
-        scene.core.setCollider(params['collider'])
+    choice = getattr(scene, 'colliderChoice', None)   # (iteration, name, parameters) from a collider engine
+    collider = choice[1] if choice is not None and choice[0] == O.iter else params['collider']
+    if scene.core.collider() != collider:
+        scene.core.setCollider(collider)
     O.dt = scene.core.step(settings)
     if _syncNeeded(params, engines):
         scene.sync()

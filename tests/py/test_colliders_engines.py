@@ -1,0 +1,166 @@
+"""Collider engines (DESSCollider, NBSCollider, AllPairsCollider, MSCCollider) and compareColliders."""
+import json
+import math
+
+import pytest
+
+import yade_dda
+from yade_dda import (O, ddaBlock, DDAIntegrator, DESSCollider, NBSCollider, AllPairsCollider, MSCCollider,
+                      compareColliders)
+from yade_dda import engines as _engines
+from yade_dda import scene as _scene
+from yade import wrapper
+
+from helpers import box, material, rotate
+
+G = 9.81
+ENGINES = {'DESS': DESSCollider, 'NBS': NBSCollider, 'AllPairs': AllPairsCollider}
+
+
+def smallPile():
+    """A fixed floor and 6 slender, slightly turned bars in two crossing layers, 1 cm apart: (vertices, fixed)."""
+    blocks = [(box((-4, -4, -1), (4, 4, 0)), True)]
+    for k in range(6):
+        layer, i = divmod(k, 3)
+        lo, hi = ((-3, -1.6 + 1.2 * i, 0.01), (3, -0.8 + 1.2 * i, 0.81)) if layer == 0 else \
+            ((-1.6 + 1.2 * i, -3, 0.83), (-0.8 + 1.2 * i, 3, 1.63))
+        centre = tuple((a + b) / 2 for a, b in zip(lo, hi))
+        blocks.append((rotate(box(lo, hi), (0, 0, 1), 0.05 * (k - 2.5), about=centre), False))
+    return blocks
+
+
+def build(blocks, engines):
+    O.reset()
+    rock = material(O, young=1e9, frictionDeg=30)
+    ids = [O.bodies.append(ddaBlock(points, material=rock, fixed=fixed)) for points, fixed in blocks]
+    O.engines = engines
+    return ids
+
+
+def integrator(**kw):
+    return DDAIntegrator(dt=1e-3, gravity=(0, 0, -G), maxDisplacement=0.005, label='dda', **kw)
+
+
+@pytest.mark.parametrize('name', sorted(ENGINES))
+def test_engine_selects_its_strategy(scene, name):
+    build(smallPile(), [ENGINES[name](label='collider'), integrator(collider='AllPairs' if name != 'AllPairs' else 'NBS')])
+    O.run(3, True)
+    assert _scene.current().core.collider() == name            # the engine wins over DDAIntegrator.collider
+    assert O.engines[0].strategy == name and O.engines[0].label == 'collider'
+    s = yade_dda.stats()
+    pairs = 7 * 6 // 2                                         # every pair of the 7 blocks (only one is fixed)
+    if name == 'AllPairs':
+        assert s['candidatePairs'] == pairs
+    else:
+        assert s['contactPairs'] <= s['candidatePairs'] <= pairs
+    assert s['contactPairs'] > 0
+
+
+def test_engine_command_carries_the_choice_and_is_cheap_to_recognise(scene):
+    engine = NBSCollider()
+    assert engine.command.startswith('import yade_dda.')        # not a reader that forces a sync every step
+    assert "_select('NBS')" in engine.command
+    assert engine.iterPeriod == 1 and engine.initRun
+    with pytest.raises(TypeError) as error:
+        DESSCollider(segments=3)
+    assert 'DESSCollider has no parameter segments' in str(error.value)
+
+
+def test_without_engine_the_integrator_parameter_applies_again(scene):
+    build(smallPile(), [NBSCollider(label='collider'), integrator(collider='AllPairs')])
+    O.run(2, True)
+    assert _scene.current().core.collider() == 'NBS'
+    O.engines = [O.engines[1]]                                  # collider engine removed
+    O.run(2, True)
+    assert _scene.current().core.collider() == 'AllPairs'
+
+
+def test_collider_engine_after_the_integrator_is_refused(scene):
+    build(smallPile(), [integrator(), DESSCollider()])
+    with pytest.raises(RuntimeError) as error:
+        O.run(1, True)
+    assert 'must come before DDAIntegrator' in str(error.value)
+
+
+def test_same_trajectories_with_every_strategy(scene):
+    """All strategies find the same contacts, so the blocks move identically (bit for bit)."""
+    results = {}
+    for name, engine in ENGINES.items():
+        ids = build(smallPile(), [engine(label='collider'), integrator()])
+        closed = []
+        for _ in range(12):
+            O.run(10, True)
+            closed.append(yade_dda.stats()['closedContacts'])
+        results[name] = ([tuple(O.bodies[i].state.pos) for i in ids], [tuple(O.bodies[i].state.ori) for i in ids],
+                         closed, O.time)
+        assert max(closed) > 0                                 # the pile has landed: contacts are exercised
+    reference = results['AllPairs']
+    for name in ENGINES:
+        assert results[name] == reference, name
+
+
+def test_msc_collider_raises_clearly_while_unavailable(scene):
+    if 'MSC' in _engines._COLLIDERS:
+        engine = MSCCollider(criticalLength=2.0, segments=4)
+        assert engine.criticalLength == 2.0 and engine.segments == 4
+        assert "_select('MSC', criticalLength=2.0, segments=4)" in engine.command
+        return
+    with pytest.raises(NotImplementedError) as error:
+        MSCCollider(criticalLength=2.0, segments=4)
+    message = str(error.value)
+    assert 'multi-shell cover' in message and 'DESSCollider' in message
+
+
+def test_msc_parameters_are_checked_and_stored(scene, monkeypatch):
+    monkeypatch.setattr(_engines, '_COLLIDERS', _engines._COLLIDERS + ('MSC',) * ('MSC' not in _engines._COLLIDERS))
+    engine = MSCCollider(label='msc')
+    assert (engine.criticalLength, engine.segments) == (0.0, 3)
+    engine.segments = 5
+    assert 'segments=5' in engine.command
+    with pytest.raises(ValueError):
+        MSCCollider(criticalLength=-1)
+    with pytest.raises(ValueError):
+        MSCCollider(segments=0)
+    with pytest.raises(ValueError):
+        MSCCollider(segments=2.5)
+
+
+def test_compare_colliders_on_a_tiny_scene(scene, tmp_path):
+    out = tmp_path / 'cmp' / 'result.json'
+    result = compareColliders(smallPile, steps=5, dt=1e-3, gravity=(0, 0, -G), out=str(out),
+                              integrator=dict(maxDisplacement=0.005), verbose=False)
+    names = [r['strategy'] for r in result['rows']]
+    ours = [n for n in ('MSC', 'DESS', 'NBS', 'AllPairs') if n in _engines._COLLIDERS]
+    assert names == ours + ['InsertionSortCollider', 'SpatialQuickSortCollider']
+    assert result['reference'] == ('MSC' if 'MSC' in ours else 'DESS')
+    if 'MSC' not in ours:
+        assert 'MSC' in result['skipped']
+    for row in result['rows']:
+        assert row['steps'] == 5
+        assert row['detectionMs'] > 0 and row['candidatePairs'] >= row['contactPairs'] >= 0
+        assert len(result['perStep'][row['strategy']]['detectionMs']) == 5
+    rows = {r['strategy']: r for r in result['rows']}
+    assert rows['AllPairs']['candidatePairs'] == 7 * 6 // 2
+    assert rows['DESS']['contactPairs'] == rows['AllPairs']['contactPairs'] == rows['NBS']['contactPairs']
+    assert all(d == 0 for d in result['trajectoryDifference'].values())
+    # what YADE was told is in the output
+    yadeTold = result['told']['InsertionSortCollider']
+    assert yadeTold['dt'] == 1e-3 and 'verletDist=0.0' in yadeTold['engines'][1]
+    assert 'NewtonIntegrator(damping=0.0, gravity=(0.0, 0.0, -9.81))' in yadeTold['engines']
+    assert yadeTold['finite']
+    saved = json.loads(out.read_text())
+    assert saved['settings']['dt'] == 1e-3 and saved['settings']['blocks'] == 7
+    assert [r['strategy'] for r in saved['rows']] == names
+    for path in result['files'][1:]:
+        with open(path, 'rb') as f:
+            assert f.read(8) == b'\x89PNG\r\n\x1a\n'
+    assert len(result['files']) == 3
+
+
+def test_compare_colliders_rejects_bad_input(scene, tmp_path):
+    with pytest.raises(ValueError):
+        compareColliders(smallPile, steps=0, out=str(tmp_path / 'x.json'))
+    with pytest.raises(ValueError):
+        compareColliders(smallPile, strategies=('Octree',), out=str(tmp_path / 'x.json'))
+    with pytest.raises(ValueError):
+        compareColliders(smallPile, integrator=dict(dt=1), out=str(tmp_path / 'x.json'))
