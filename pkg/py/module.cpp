@@ -7,6 +7,7 @@
 // dda::InputError (a std::invalid_argument) -> ValueError, std::out_of_range ->
 // IndexError, anything else -> RuntimeError.
 #include "SceneLink.hpp"
+#include "dda/collider/MSCCollider.hpp"
 
 #include <boost/python.hpp>
 
@@ -197,8 +198,10 @@ void setCollider(SceneLink& s, const std::string& name) {
 		s.world.setCollider(std::make_unique<NBSCollider>());
 	else if (name == "AllPairs")
 		s.world.setCollider(std::make_unique<AllPairsCollider>());
+	else if (name == "MSC")
+		s.world.setCollider(std::make_unique<MSCCollider>());
 	else
-		throw InputError("unknown collider '" + name + "' (known: DESS, NBS, AllPairs)");
+		throw InputError("unknown collider '" + name + "' (known: DESS, NBS, AllPairs, MSC)");
 }
 std::string colliderName(const SceneLink& s) { return s.world.collider().name(); }
 

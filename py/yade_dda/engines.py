@@ -48,7 +48,7 @@ class _Parameter:
         engine._updateCommand()
 
 
-_COLLIDERS = ('DESS', 'NBS', 'AllPairs')
+_COLLIDERS = ('DESS', 'NBS', 'AllPairs', 'MSC')
 
 
 def _colliderName(value):

@@ -9,8 +9,9 @@ void AllPairsCollider::findPairs(const std::vector<Block>& blocks, double, std::
 	for (int a = 0; a < n; ++a)
 		for (int b = a + 1; b < n; ++b)
 			if (!(blocks[a].fixed && blocks[b].fixed)) pairs.emplace_back(a, b);
+	stats = BroadPhaseStatistics{};
 	stats.candidatePairs = static_cast<long>(pairs.size());
-	stats.shellPairs = stats.candidatePairs;
+	for (auto [a, b] : pairs) stats.subUnitPairs += allSubUnitPairs(*blocks[a].shape, *blocks[b].shape);
 }
 
 }  // namespace dda

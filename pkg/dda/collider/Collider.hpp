@@ -24,10 +24,38 @@ namespace dda {
 // half of d0 per side would miss those pairs (the collider test caught it).
 constexpr double kBroadPhaseMarginFactor = 1.0;
 
+// Counters of one findPairs call (they describe that call only).
 struct BroadPhaseStatistics {
 	long candidatePairs = 0;  // block pairs handed to the narrow phase
-	long shellPairs = 0;      // bounding-volume pairs tested (strategy-specific)
+	long shellPairs = 0;      // overlapping bounding-volume pairs found (MSC: shell pairs)
+	long shellTests = 0;      // bounding-volume comparisons made
+	long shells = 0;          // bounding volumes (DESS, NBS: one per block; AllPairs: none)
+	long shellUpdates = 0;    // bounding volumes recomputed from corners this call
+	// The narrow phase's "sub-unit loops" (Wu et al. 2014, Sec. 4.2): over the
+	// candidate pairs (a, b), Va x Fb + Vb x Fa + Ea x Eb, with V, E, F the
+	// vertices, edges and faces each block offers the pair (MSC: the linked
+	// sub-units of the overlapping shells; other strategies: all of them).
+	long subUnitPairs = 0;
 };
+
+// The sub-units (vertices, edges, faces: indices into the blocks' shapes) a
+// broad phase links to one candidate pair (a, b): [0] of block a, [1] of
+// block b, each sorted and unique.
+struct LinkedSubUnits {
+	std::array<std::vector<int>, 2> vertices, edges, faces;
+	long subUnitPairs() const {
+		const auto n = [](const std::vector<int>& v) { return static_cast<long>(v.size()); };
+		return n(vertices[0]) * n(faces[1]) + n(vertices[1]) * n(faces[0]) + n(edges[0]) * n(edges[1]);
+	}
+};
+
+// The sub-unit loops of a pair when every sub-unit takes part.
+inline long allSubUnitPairs(const ConvexPolyhedron& a, const ConvexPolyhedron& b) {
+	const auto v = [](const ConvexPolyhedron& s) { return static_cast<long>(s.vertices.size()); };
+	const auto e = [](const ConvexPolyhedron& s) { return static_cast<long>(s.edges.size()); };
+	const auto f = [](const ConvexPolyhedron& s) { return static_cast<long>(s.faces.size()); };
+	return v(a) * f(b) + v(b) * f(a) + e(a) * e(b);
+}
 
 class Collider {
 public:
@@ -37,6 +65,10 @@ public:
 	// (a, b) (so that results do not depend on the strategy's internals).
 	virtual void findPairs(const std::vector<Block>& blocks, double contactDistance,
 	                       std::vector<std::pair<int, int>>& pairs, BroadPhaseStatistics& stats) = 0;
+	// The sub-units linked to candidate pair pairIndex of the last findPairs
+	// (its index in `pairs`), or nullptr: strategies without sub-block volumes
+	// link every sub-unit. Valid until the next findPairs.
+	virtual const LinkedSubUnits* linked(int /*pairIndex*/) const { return nullptr; }
 };
 
 // Every pair of blocks that are not both fixed: O(n^2), the reference.

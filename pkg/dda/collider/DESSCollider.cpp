@@ -19,10 +19,9 @@ void DESSCollider::findPairs(const std::vector<Block>& blocks, double contactDis
 		boxes_[b] = box;
 		all.extend(box.center());
 	}
-	if (n < 2) {
-		stats.candidatePairs = stats.shellPairs = 0;
-		return;
-	}
+	stats = BroadPhaseStatistics{};
+	stats.shells = stats.shellUpdates = n;
+	if (n < 2) return;
 	int axis;
 	all.sizes().maxCoeff(&axis);
 	order_.resize(n);
@@ -44,8 +43,9 @@ void DESSCollider::findPairs(const std::vector<Block>& blocks, double contactDis
 		}
 	}
 	std::sort(pairs.begin(), pairs.end());
-	stats.candidatePairs = static_cast<long>(pairs.size());
-	stats.shellPairs = tested;
+	stats.candidatePairs = stats.shellPairs = static_cast<long>(pairs.size());
+	stats.shellTests = tested;
+	for (auto [a, b] : pairs) stats.subUnitPairs += allSubUnitPairs(*blocks[a].shape, *blocks[b].shape);
 }
 
 }  // namespace dda

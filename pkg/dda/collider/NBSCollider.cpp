@@ -19,8 +19,9 @@ std::uint64_t cellKey(std::int64_t x, std::int64_t y, std::int64_t z) {
 void NBSCollider::findPairs(const std::vector<Block>& blocks, double contactDistance,
                            std::vector<std::pair<int, int>>& pairs, BroadPhaseStatistics& stats) {
 	pairs.clear();
-	stats.candidatePairs = stats.shellPairs = 0;
+	stats = BroadPhaseStatistics{};
 	const int n = static_cast<int>(blocks.size());
+	stats.shells = stats.shellUpdates = n;
 	if (n < 2) return;
 	centres_.resize(n);
 	radii_.resize(n);
@@ -66,8 +67,9 @@ void NBSCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 				}
 	}
 	std::sort(pairs.begin(), pairs.end());
-	stats.candidatePairs = static_cast<long>(pairs.size());
-	stats.shellPairs = tested;
+	stats.candidatePairs = stats.shellPairs = static_cast<long>(pairs.size());
+	stats.shellTests = tested;
+	for (auto [a, b] : pairs) stats.subUnitPairs += allSubUnitPairs(*blocks[a].shape, *blocks[b].shape);
 }
 
 }  // namespace dda

@@ -1,0 +1,497 @@
+// The multi-shell cover collider: it finds the all-pairs contact set on random
+// scenes, its shells cover their blocks (also after the blocks moved), the
+// sub-units it links to a pair hold every feature of the pair's contacts, it
+// beats DESS on slender scenes, and fixed blocks' shells are built once.
+#include "dda/collider/Collider.hpp"
+#include "dda/collider/MSCCollider.hpp"
+#include "dda/contact/PairDetection.hpp"
+#include "dda/solver/World.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <random>
+#include <set>
+#include <tuple>
+
+using namespace dda;
+
+namespace {
+
+std::vector<Vector3> orientedBox(const Vector3& centre, const Vector3& half, const Eigen::Matrix3d& R) {
+	std::vector<Vector3> points;
+	for (int i = 0; i < 8; ++i) {
+		const Vector3 local((i & 1 ? 1 : -1) * half.x(), (i & 2 ? 1 : -1) * half.y(), (i & 4 ? 1 : -1) * half.z());
+		points.push_back(centre + R * local);
+	}
+	return points;
+}
+
+Eigen::Matrix3d randomRotation(std::mt19937& rng) {
+	std::uniform_real_distribution<double> unit(0, 1);
+	const Vector3 axis = Vector3(unit(rng) - 0.5, unit(rng) - 0.5, unit(rng) - 0.5).normalized();
+	return Eigen::AngleAxisd(3.2 * unit(rng), axis).toRotationMatrix();
+}
+
+// As in test_colliders.cpp: slender (up to 30:1, 15 m long) and compact boxes,
+// randomly turned, packed so that many touch or overlap; some fixed; exact
+// corner-to-corner and edge-to-edge placements.
+World randomScene(int n, unsigned seed) {
+	std::mt19937 rng(seed);
+	std::uniform_real_distribution<double> unit(0, 1);
+	World world;
+	Material material;
+	for (int k = 0; k < n; ++k) {
+		const double length = unit(rng) < 0.5 ? 1 + 14 * unit(rng) : 1 + unit(rng);
+		const Vector3 half(0.5 * length, 0.25 + 0.25 * unit(rng), 0.25 + 0.25 * unit(rng));
+		const Eigen::Matrix3d R = randomRotation(rng);
+		const Vector3 centre(25 * unit(rng), 25 * unit(rng), 25 * unit(rng));
+		world.addBlock(orientedBox(centre, half, R), material, unit(rng) < 0.3);
+	}
+	const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+	world.addBlock(orientedBox(Vector3(30, 0, 0), Vector3(0.5, 0.5, 0.5), I), material, false);
+	world.addBlock(orientedBox(Vector3(31, 1, 1), Vector3(0.5, 0.5, 0.5), I), material, false);
+	world.addBlock(orientedBox(Vector3(30, 3, 0), Vector3(0.5, 0.5, 0.5), I), material, true);
+	world.addBlock(orientedBox(Vector3(31, 3, 1), Vector3(0.5, 0.5, 0.5), I), material, false);
+	// A long block lying along the edge of another, exactly: the contact sits
+	// on the first one's slab planes.
+	world.addBlock(orientedBox(Vector3(40, 0, 0), Vector3(10, 0.5, 0.5), I), material, false);
+	world.addBlock(orientedBox(Vector3(40, 1, 1), Vector3(0.5, 0.5, 0.5), I), material, false);
+	world.addBlock(orientedBox(Vector3(40 + 10 / 3.0, 0, 1), Vector3(0.5, 0.5, 0.5), I), material, false);
+	return world;
+}
+
+// A log pile: layers of 10:1:1 blocks, each layer across the one below,
+// slightly turned, with gaps and penetrations between -0.4 d0 and d0 (the
+// states DDA keeps contacts in), some blocks fixed.
+World logPile(double d0, unsigned seed) {
+	std::mt19937 rng(seed);
+	std::uniform_real_distribution<double> unit(0, 1);
+	World world;
+	Material material;
+	const auto gap = [&] { return d0 * (-0.4 + 1.4 * unit(rng)); };
+	double z = 0.5;
+	for (int layer = 0; layer < 4; ++layer) {
+		const double turn = (layer % 2 ? M_PI / 2 : 0) + 0.02 * (unit(rng) - 0.5);
+		const Eigen::Matrix3d R = Eigen::AngleAxisd(turn, Vector3::UnitZ()).toRotationMatrix();
+		double y = -4.5;
+		for (int k = 0; k < 8; ++k) {
+			const Vector3 axis = Vector3(unit(rng) - 0.5, unit(rng) - 0.5, unit(rng) - 0.5).normalized();
+			const Eigen::Matrix3d tilt = Eigen::AngleAxisd(1e-4 * unit(rng), axis).toRotationMatrix();
+			world.addBlock(orientedBox(R * Vector3(0, y, 0) + Vector3(0, 0, z), Vector3(5, 0.5, 0.5), R * tilt), material,
+			               layer == 0 && k % 3 == 0);
+			y += 1 + gap();
+		}
+		z += 1 + gap();
+	}
+	return world;
+}
+
+std::vector<Block> blocksOf(const World& world) {
+	std::vector<Block> blocks;
+	for (int i = 0; i < world.blockCount(); ++i) blocks.push_back(world.block(i));
+	return blocks;
+}
+
+DetectionSettings detection(double d0) {
+	DetectionSettings settings;
+	settings.contactDistance = d0;
+	settings.lengthTolerance = 1e-9;
+	return settings;
+}
+
+std::optional<PairContacts> detect(const std::vector<Block>& blocks, int a, int b, double d0) {
+	return detectPairContacts(BlockGeometry{blocks[a].shape.get(), &blocks[a].vertices, blocks[a].centroid},
+	                          BlockGeometry{blocks[b].shape.get(), &blocks[b].vertices, blocks[b].centroid},
+	                          detection(d0));
+}
+
+using ContactSet = std::set<std::tuple<int, int, int, bool, int, int>>;
+
+ContactSet contactSet(Collider& collider, const std::vector<Block>& blocks, double d0,
+                      BroadPhaseStatistics* statsOut = nullptr) {
+	std::vector<std::pair<int, int>> pairs;
+	BroadPhaseStatistics stats;
+	collider.findPairs(blocks, d0, pairs, stats);
+	EXPECT_TRUE(std::is_sorted(pairs.begin(), pairs.end()));
+	EXPECT_TRUE(std::adjacent_find(pairs.begin(), pairs.end()) == pairs.end()) << "pairs are unique";
+	EXPECT_EQ(stats.candidatePairs, static_cast<long>(pairs.size()));
+	if (statsOut) *statsOut = stats;
+	ContactSet out;
+	for (auto [a, b] : pairs) {
+		EXPECT_LT(a, b);
+		EXPECT_FALSE(blocks[a].fixed && blocks[b].fixed);
+		const auto result = detect(blocks, a, b, d0);
+		if (!result) continue;
+		for (const SubContact& c : result->contacts)
+			out.insert({a, b, static_cast<int>(c.kind), c.firstIsA, c.feature1, c.feature2});
+	}
+	return out;
+}
+
+bool has(const std::vector<int>& sorted, int x) { return std::binary_search(sorted.begin(), sorted.end(), x); }
+
+// Checks that every feature of every sub-contact of the MSC candidates is
+// linked to the pair; returns the number of sub-contacts checked.
+int checkLinkedFeatures(const std::vector<Block>& blocks, double d0, MSCCollider msc = MSCCollider()) {
+	std::vector<std::pair<int, int>> pairs;
+	BroadPhaseStatistics stats;
+	msc.findPairs(blocks, d0, pairs, stats);
+	int checked = 0;
+	long loops = 0;
+	for (int p = 0; p < static_cast<int>(pairs.size()); ++p) {
+		const LinkedSubUnits* linked = msc.linked(p);
+		if (!linked) {
+			ADD_FAILURE() << "no linked sub-units for pair " << p;
+			continue;
+		}
+		loops += linked->subUnitPairs();
+		for (int i = 0; i < 2; ++i)
+			for (const auto* set : {&linked->vertices[i], &linked->edges[i], &linked->faces[i]}) {
+				EXPECT_TRUE(std::is_sorted(set->begin(), set->end()));
+				EXPECT_TRUE(std::adjacent_find(set->begin(), set->end()) == set->end());
+			}
+		const auto [a, b] = pairs[p];
+		const auto result = detect(blocks, a, b, d0);
+		if (!result) continue;
+		for (const SubContact& c : result->contacts) {
+			const int i = c.firstIsA ? 0 : 1, j = 1 - i;
+			if (c.kind == ContactKind::VertexFace) {
+				EXPECT_TRUE(has(linked->vertices[i], c.feature1))
+				    << "pair " << a << "-" << b << " vertex " << c.feature1 << " (d0 " << d0 << ")";
+				EXPECT_TRUE(has(linked->faces[j], c.feature2))
+				    << "pair " << a << "-" << b << " face " << c.feature2 << " (d0 " << d0 << ")";
+			} else {
+				EXPECT_TRUE(has(linked->edges[i], c.feature1))
+				    << "pair " << a << "-" << b << " edge " << c.feature1 << " (d0 " << d0 << ")";
+				EXPECT_TRUE(has(linked->edges[j], c.feature2))
+				    << "pair " << a << "-" << b << " edge " << c.feature2 << " (d0 " << d0 << ")";
+			}
+			++checked;
+		}
+	}
+	EXPECT_EQ(stats.subUnitPairs, loops);
+	EXPECT_EQ(msc.linked(static_cast<int>(pairs.size())), nullptr);
+	return checked;
+}
+
+// A point of the block: a random convex combination of its corners.
+Vector3 pointInside(const Block& block, std::mt19937& rng) {
+	std::exponential_distribution<double> weight(1.0);
+	Vector3 sum = Vector3::Zero();
+	double total = 0;
+	for (const Vector3& x : block.vertices) {
+		const double w = std::pow(weight(rng), 3);  // spiky: points near corners and edges too
+		sum += w * x;
+		total += w;
+	}
+	return sum / total;
+}
+
+bool inShells(const MSCCollider& msc, int block, const Vector3& x, double tolerance) {
+	for (int s = 0; s < msc.shellCount(block); ++s) {
+		const Eigen::AlignedBox3d& box = msc.shellBox(block, s);
+		if (((box.min().array() - tolerance) <= x.array()).all() && (x.array() <= (box.max().array() + tolerance)).all())
+			return true;
+	}
+	return false;
+}
+
+}  // namespace
+
+TEST(MSCCollider, FindsTheAllPairsContactSet) {
+	for (unsigned seed : {1u, 2u, 3u, 4u}) {
+		const std::vector<Block> blocks = blocksOf(randomScene(120, seed));
+		for (double d0 : {0.0, 0.05, 0.5}) {
+			AllPairsCollider all;
+			const ContactSet reference = contactSet(all, blocks, d0);
+			ASSERT_GT(reference.size(), 10u);
+			MSCCollider msc;
+			const ContactSet fromMsc = contactSet(msc, blocks, d0);
+			for (const auto& c : reference)
+				if (!fromMsc.count(c)) ADD_FAILURE() << "MSC misses " << std::get<0>(c) << "-" << std::get<1>(c);
+			EXPECT_TRUE(fromMsc == reference) << "seed " << seed << " d0 " << d0;
+			// More slabs, and every block cut.
+			MSCCollider fine(0.5, 7);
+			EXPECT_TRUE(contactSet(fine, blocks, d0) == reference) << "seed " << seed << " d0 " << d0;
+		}
+	}
+}
+
+TEST(MSCCollider, LinksEveryFeatureOfTheContacts) {
+	// Random scenes, deep overlaps included (the design argument covers
+	// penetrations up to d0 / 2; deeper ones hold on these scenes too).
+	int checked = 0;
+	for (unsigned seed : {1u, 2u, 3u})
+		for (double d0 : {0.0, 0.05, 0.5}) {
+			const std::vector<Block> blocks = blocksOf(randomScene(120, seed));
+			checked += checkLinkedFeatures(blocks, d0);
+			checkLinkedFeatures(blocks, d0, MSCCollider(0.5, 7));  // every block cut, in 7
+		}
+	EXPECT_GT(checked, 500);
+	// Log piles: contacts in DDA's range of penetration, across slab planes.
+	int pile = 0;
+	for (unsigned seed : {1u, 2u})
+		for (double d0 : {0.01, 0.1}) {
+			const std::vector<Block> blocks = blocksOf(logPile(d0, seed));
+			pile += checkLinkedFeatures(blocks, d0);
+			checkLinkedFeatures(blocks, d0, MSCCollider(3, 9));
+		}
+	EXPECT_GT(pile, 1000);
+}
+
+TEST(MSCCollider, FewerCandidatesAndSubUnitLoopsThanDESSOnSlenderScenes) {
+	Material material;
+	// 200 randomly turned 20 x 1 x 1 m blocks in a 40 m box.
+	World sticks;
+	std::mt19937 rng(7);
+	std::uniform_real_distribution<double> unit(0, 1);
+	for (int k = 0; k < 200; ++k)
+		sticks.addBlock(orientedBox(Vector3(40 * unit(rng), 40 * unit(rng), 40 * unit(rng)), Vector3(10, 0.5, 0.5),
+		                            randomRotation(rng)),
+		                material, k % 10 == 0);
+	// A row of ten 10 x 1 x 1 m blocks at 45 degrees in the x-y plane, side by
+	// side, 1 cm apart.
+	World row;
+	const Eigen::Matrix3d slant = Eigen::AngleAxisd(M_PI / 4, Vector3::UnitZ()).toRotationMatrix();
+	for (int k = 0; k < 10; ++k)
+		row.addBlock(orientedBox(slant * Vector3(0, 1.01 * k, 0), Vector3(5, 0.5, 0.5), slant), material, k == 0);
+	for (const World* world : {&sticks, &row}) {
+		const std::vector<Block> blocks = blocksOf(*world);
+		for (double d0 : {0.02, 0.2}) {
+			AllPairsCollider all;
+			DESSCollider dess;
+			MSCCollider msc;
+			BroadPhaseStatistics allStats, dessStats, mscStats;
+			const ContactSet reference = contactSet(all, blocks, d0, &allStats);
+			EXPECT_TRUE(contactSet(dess, blocks, d0, &dessStats) == reference);
+			EXPECT_TRUE(contactSet(msc, blocks, d0, &mscStats) == reference);
+			EXPECT_LE(mscStats.candidatePairs, dessStats.candidatePairs) << "d0 " << d0;
+			EXPECT_LT(mscStats.subUnitPairs, dessStats.subUnitPairs) << "d0 " << d0;
+			EXPECT_GE(mscStats.shellPairs, mscStats.candidatePairs);
+			EXPECT_EQ(mscStats.shells, 3L * world->blockCount());  // every block is long
+			EXPECT_EQ(dessStats.shells, world->blockCount());
+		}
+	}
+	// The row: DESS's 45-degree boxes reach far past each neighbour; MSC
+	// proposes fewer pairs, still every pair of neighbours (9 contacts pairs).
+	const std::vector<Block> blocks = blocksOf(row);
+	DESSCollider dess;
+	MSCCollider msc;
+	std::vector<std::pair<int, int>> dessPairs, mscPairs;
+	BroadPhaseStatistics stats;
+	dess.findPairs(blocks, 0.02, dessPairs, stats);
+	msc.findPairs(blocks, 0.02, mscPairs, stats);
+	EXPECT_LT(mscPairs.size(), dessPairs.size());
+	for (int k = 0; k + 1 < 10; ++k)
+		EXPECT_TRUE(std::binary_search(mscPairs.begin(), mscPairs.end(), std::make_pair(k, k + 1))) << k;
+}
+
+TEST(MSCCollider, ShellsCoverTheirBlocksAlsoAfterAffineMotion) {
+	std::vector<Block> blocks = blocksOf(randomScene(60, 5));
+	// One block of its own cover: 9 slabs from 1 m long.
+	MSCCollider msc;
+	msc.setBlockCover(0, 1.0, 9);
+	std::mt19937 rng(11);
+	std::uniform_real_distribution<double> unit(0, 1);
+	for (int round = 0; round < 3; ++round) {
+		std::vector<std::pair<int, int>> pairs;
+		BroadPhaseStatistics stats;
+		msc.findPairs(blocks, 0.1, pairs, stats);
+		long shells = 0;
+		for (int b = 0; b < static_cast<int>(blocks.size()); ++b) {
+			const Block& block = blocks[b];
+			shells += msc.shellCount(b);
+			double longest = 0;
+			for (const auto& e : block.shape->edges)
+				longest = std::max(longest, (block.vertices[e[1]] - block.vertices[e[0]]).norm());
+			if (b == 0)
+				EXPECT_EQ(msc.shellCount(b), 9);
+			else if (round == 0)  // lengths change a little once the blocks are strained
+				EXPECT_EQ(msc.shellCount(b), longest > 3 * block.size ? 3 : 1) << b;
+			Eigen::AlignedBox3d box;
+			for (const Vector3& x : block.vertices) box.extend(x);
+			const double tolerance = 1e-12 * box.diagonal().norm();
+			for (const Vector3& x : block.vertices) EXPECT_TRUE(inShells(msc, b, x, tolerance)) << "block " << b;
+			for (int k = 0; k < 200; ++k) {
+				const Vector3 x = pointInside(block, rng);
+				EXPECT_TRUE(inShells(msc, b, x, tolerance)) << "block " << b << " point " << x.transpose();
+			}
+			// Each shell lies within the block's box: the cover is never coarser than DESS's.
+			for (int s = 0; s < msc.shellCount(b); ++s)
+				EXPECT_TRUE(box.contains(msc.shellBox(b, s))) << "block " << b << " shell " << s;
+		}
+		EXPECT_EQ(stats.shells, shells);
+		// Move every free block by an affine map: turn, stretch by up to 10 %, shift.
+		for (Block& block : blocks) {
+			if (block.fixed) continue;
+			const Eigen::Matrix3d strain =
+			    Eigen::Matrix3d::Identity() + 0.1 * Eigen::Matrix3d::NullaryExpr([&](int, int) { return unit(rng) - 0.5; });
+			const Eigen::Matrix3d map = randomRotation(rng) * strain;
+			const Vector3 shift(unit(rng), unit(rng), unit(rng));
+			for (Vector3& x : block.vertices) x = block.centroid + shift + map * (x - block.centroid);
+			block.centroid += shift;
+		}
+	}
+	EXPECT_EQ(msc.coverBuilds(), static_cast<long>(blocks.size()));  // topology once
+}
+
+TEST(MSCCollider, FixedBlocksShellsAreBuiltOnceAndFixedPairsNeverProposed) {
+	const std::vector<Block> blocks = blocksOf(randomScene(100, 9));
+	MSCCollider msc;
+	long fixedShells = 0, allShells = 0;
+	std::vector<std::pair<int, int>> pairs;
+	BroadPhaseStatistics stats;
+	for (int call = 0; call < 3; ++call) {
+		msc.findPairs(blocks, 0.05, pairs, stats);
+		if (call == 0) {
+			for (int b = 0; b < static_cast<int>(blocks.size()); ++b) {
+				allShells += msc.shellCount(b);
+				if (blocks[b].fixed) fixedShells += msc.shellCount(b);
+			}
+			ASSERT_GT(fixedShells, 10);
+			EXPECT_EQ(stats.shellUpdates, allShells);
+		} else {
+			EXPECT_EQ(stats.shellUpdates, allShells - fixedShells);
+		}
+		for (auto [a, b] : pairs) EXPECT_FALSE(blocks[a].fixed && blocks[b].fixed) << a << "-" << b;
+	}
+	EXPECT_EQ(msc.totalShellUpdates(), allShells + 2 * (allShells - fixedShells));
+	EXPECT_EQ(msc.coverBuilds(), static_cast<long>(blocks.size()));
+	// A block more: every cover is rebuilt, every box recomputed once.
+	std::vector<Block> more = blocks;
+	more.push_back(blocks.back());
+	msc.findPairs(more, 0.05, pairs, stats);
+	EXPECT_EQ(msc.coverBuilds(), static_cast<long>(2 * blocks.size() + 1));
+	EXPECT_EQ(stats.shellUpdates, allShells + msc.shellCount(static_cast<int>(blocks.size())));
+
+	// Two fixed cubes side by side and a free one beside both.
+	World world;
+	Material material;
+	const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+	world.addBlock(orientedBox(Vector3(0, 0, 0), Vector3(0.5, 0.5, 0.5), I), material, true);
+	world.addBlock(orientedBox(Vector3(1, 0, 0), Vector3(0.5, 0.5, 0.5), I), material, true);
+	world.addBlock(orientedBox(Vector3(0, 1, 0), Vector3(0.5, 0.5, 0.5), I), material, false);
+	MSCCollider small;
+	small.findPairs(blocksOf(world), 0.1, pairs, stats);
+	const std::vector<std::pair<int, int>> expected{{0, 2}, {1, 2}};
+	EXPECT_EQ(pairs, expected);
+}
+
+TEST(MSCCollider, StatisticsAndLinkedSetsOfEveryStrategy) {
+	const std::vector<Block> blocks = blocksOf(randomScene(80, 4));
+	std::unique_ptr<Collider> others[] = {std::make_unique<AllPairsCollider>(), std::make_unique<DESSCollider>(),
+	                                      std::make_unique<NBSCollider>()};
+	for (auto& collider : others) {
+		std::vector<std::pair<int, int>> pairs;
+		BroadPhaseStatistics stats;
+		collider->findPairs(blocks, 0.05, pairs, stats);
+		long loops = 0;
+		for (auto [a, b] : pairs) loops += allSubUnitPairs(*blocks[a].shape, *blocks[b].shape);
+		EXPECT_EQ(stats.subUnitPairs, loops) << collider->name();
+		EXPECT_EQ(stats.subUnitPairs, 240 * stats.candidatePairs) << "boxes: 8 x 6 x 2 + 12 x 12";
+		EXPECT_EQ(collider->linked(0), nullptr) << collider->name();
+		EXPECT_LE(stats.shellPairs, stats.shellTests + stats.candidatePairs) << collider->name();
+	}
+	// MSC: a block of one shell links everything.
+	MSCCollider msc;
+	std::vector<std::pair<int, int>> pairs;
+	BroadPhaseStatistics stats;
+	msc.findPairs(blocks, 0.05, pairs, stats);
+	ASSERT_FALSE(pairs.empty());
+	EXPECT_LE(stats.subUnitPairs, 240 * stats.candidatePairs);
+	for (int p = 0; p < static_cast<int>(pairs.size()); ++p) {
+		const LinkedSubUnits* linked = msc.linked(p);
+		ASSERT_NE(linked, nullptr);
+		const auto [a, b] = pairs[p];
+		if (msc.shellCount(a) == 1) EXPECT_EQ(linked->vertices[0].size(), 8u);
+		if (msc.shellCount(b) == 1) EXPECT_EQ(linked->faces[1].size(), 6u);
+		// A middle slab of a box holds no corner (the paper's Table 2, shell B),
+		// but always edges and faces.
+		for (int i = 0; i < 2; ++i) EXPECT_FALSE(linked->edges[i].empty() || linked->faces[i].empty());
+	}
+}
+
+TEST(MSCCollider, RejectsInvalidCovers) {
+	EXPECT_THROW(MSCCollider(0, 3), InputError);
+	EXPECT_THROW(MSCCollider(3, 0), InputError);
+	EXPECT_THROW(MSCCollider(3, MSCCollider::kMaxSegments + 1), InputError);
+	MSCCollider msc;
+	EXPECT_THROW(msc.setBlockCover(-1, 1, 3), InputError);
+	EXPECT_THROW(msc.setBlockCover(0, -1, 3), InputError);
+	EXPECT_THROW(msc.setBlockCover(0, std::nan(""), 3), InputError);
+	EXPECT_THROW(msc.setBlockCover(0, 1, 0), InputError);
+	EXPECT_THROW(msc.shellBox(0, 0), std::out_of_range);  // before any findPairs
+	EXPECT_THROW(msc.setCover(-1, 3), InputError);
+	EXPECT_THROW(msc.setCover(1, 0), InputError);
+	EXPECT_NO_THROW(msc.setCover(0, 2));
+}
+
+TEST(MSCCollider, SceneAndBlockCoversRebuildOnlyWhatChanged) {
+	const std::vector<Block> blocks = blocksOf(randomScene(40, 6));
+	const int n = static_cast<int>(blocks.size());
+	MSCCollider msc;
+	std::vector<std::pair<int, int>> pairs, first;
+	BroadPhaseStatistics stats;
+	msc.findPairs(blocks, 0.05, first, stats);
+	EXPECT_EQ(msc.coverBuilds(), n);
+	// A scene-wide critical length of 1.2 m and 5 segments: every block with a
+	// longer edge gets 5 shells; the contacts stay those of AllPairs.
+	msc.setCover(1.2, 5);
+	msc.findPairs(blocks, 0.05, pairs, stats);
+	for (int b = 0; b < n; ++b) {
+		double longest = 0;
+		for (const auto& e : blocks[b].shape->edges)
+			longest = std::max(longest, (blocks[b].vertices[e[1]] - blocks[b].vertices[e[0]]).norm());
+		EXPECT_EQ(msc.shellCount(b), longest > 1.2 ? 5 : 1) << b;
+	}
+	AllPairsCollider all;
+	EXPECT_TRUE(contactSet(msc, blocks, 0.05) == contactSet(all, blocks, 0.05));
+	// Back to the defaults: the same pairs as before; one block's own cover
+	// rebuilds that block only.
+	msc.setCover(0, MSCCollider::kDefaultSegments);
+	msc.findPairs(blocks, 0.05, pairs, stats);
+	EXPECT_EQ(pairs, first);
+	const long builds = msc.coverBuilds();
+	msc.setBlockCover(3, 0.1, 2);
+	msc.findPairs(blocks, 0.05, pairs, stats);
+	EXPECT_EQ(msc.coverBuilds(), builds + 1);
+	EXPECT_EQ(msc.shellCount(3), 2);
+}
+
+TEST(MSCCollider, WorldStepsAsWithDESS) {
+	// Crossed 10 x 1 x 1 m blocks dropped on a fixed floor: the same contacts,
+	// hence the same trajectory, to the last bit.
+	const auto scene = [](std::unique_ptr<Collider> collider) {
+		World world;
+		world.setCollider(std::move(collider));
+		Material material;
+		world.addBlock(orientedBox(Vector3(0, 0, -0.5), Vector3(8, 8, 0.5), Eigen::Matrix3d::Identity()), material, true);
+		for (int k = 0; k < 4; ++k) {
+			const Eigen::Matrix3d R = Eigen::AngleAxisd(k * 1.3 + 0.1, Vector3::UnitZ()).toRotationMatrix() *
+			                          Eigen::AngleAxisd(0.02 * k, Vector3::UnitX()).toRotationMatrix();
+			world.addBlock(orientedBox(Vector3(0.3 * k, -0.2 * k, 0.52 + 1.02 * k), Vector3(5, 0.5, 0.5), R), material,
+			               false);
+		}
+		IntegratorSettings settings;
+		settings.gravity = Vector3(0, 0, -9.81);
+		settings.maxTimeStep = 2e-3;
+		long contacts = 0;
+		for (int step = 0; step < 60; ++step) {
+			world.step(settings);
+			contacts += world.lastStep().contacts;
+		}
+		return std::make_pair(blocksOf(world), contacts);
+	};
+	const auto [withDess, dessContacts] = scene(std::make_unique<DESSCollider>());
+	const auto [withMsc, mscContacts] = scene(std::make_unique<MSCCollider>());
+	EXPECT_GT(dessContacts, 0);
+	EXPECT_EQ(mscContacts, dessContacts);
+	for (std::size_t b = 0; b < withDess.size(); ++b)
+		for (std::size_t v = 0; v < withDess[b].vertices.size(); ++v)
+			EXPECT_EQ(withDess[b].vertices[v], withMsc[b].vertices[v]) << "block " << b << " corner " << v;
+}
