@@ -26,7 +26,7 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.abspath(sys.argv[0] if sys.argv and sys.argv[0].endswith('.py')
                                                    else __file__)))
 from yade_dda import *          # noqa: E402,F401,F403
-import scenes                   # noqa: E402
+import paper_scenes as scenes     # noqa: E402
 import paperscript              # noqa: E402
 
 p = paperscript.readParams(steps=20000)

@@ -205,6 +205,14 @@ void setCollider(SceneLink& s, const std::string& name) {
 }
 std::string colliderName(const SceneLink& s) { return s.world.collider().name(); }
 
+// MSC's critical length lambda [m] (0 = 3 x each block's size) and segments N
+// for the whole scene; the current collider must be MSC.
+void setCover(SceneLink& s, double criticalLength, int segments) {
+	auto* msc = dynamic_cast<MSCCollider*>(&const_cast<Collider&>(s.world.collider()));
+	if (!msc) throw InputError("the scene's collider is not MSC");
+	msc->setCover(criticalLength, segments);
+}
+
 py::dict lastStep(const SceneLink& s) {
 	const StepStatistics& st = s.world.lastStep();
 	py::dict d;
@@ -218,6 +226,11 @@ py::dict lastStep(const SceneLink& s) {
 	d["unknowns"] = st.unknowns;
 	d["contactDistance"] = st.contactDistance;
 	d["candidatePairs"] = st.candidatePairs;
+	d["shellPairs"] = st.shellPairs;
+	d["shellTests"] = st.shellTests;
+	d["shells"] = st.shells;
+	d["shellUpdates"] = st.shellUpdates;
+	d["subUnitPairs"] = st.subUnitPairs;
 	d["contactPairs"] = st.contactPairs;
 	d["contacts"] = st.contacts;
 	d["closedContacts"] = st.closedContacts;
@@ -283,6 +296,7 @@ BOOST_PYTHON_MODULE(_core) {
 	          py::arg("cohesion"), py::arg("tensileStrength"), py::arg("fixed")))
 	    .def("contacts", &contactList)
 	    .def("setCollider", &setCollider)
+	    .def("setCover", &setCover)
 	    .def("detectPair", &detectPair)
 	    .def("collider", &colliderName)
 	    .def("linkBody", &linkBody)

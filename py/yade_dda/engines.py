@@ -279,9 +279,15 @@ def integratorStep(text):
         _checkEngines(scene, engines)
         scene.checkedEngines = signature
     choice = getattr(scene, 'colliderChoice', None)   # (iteration, name, parameters) from a collider engine
-    collider = choice[1] if choice is not None and choice[0] == O.iter else params['collider']
+    fromEngine = choice is not None and choice[0] == O.iter
+    collider = choice[1] if fromEngine else params['collider']
+    cover = (choice[2].get('criticalLength', 0.0), choice[2].get('segments', 3)) if fromEngine else (0.0, 3)
     if scene.core.collider() != collider:
         scene.core.setCollider(collider)
+        scene.cover = None
+    if collider == 'MSC' and getattr(scene, 'cover', None) != cover:
+        scene.core.setCover(float(cover[0]), int(cover[1]))
+        scene.cover = cover
     O.dt = scene.core.step(settings)
     if _syncNeeded(params, engines):
         scene.sync()

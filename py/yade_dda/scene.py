@@ -136,7 +136,9 @@ def stats():
     accepted above the bound), ``maxDisplacement`` and ``allowedDisplacement``
     [m], ``blocks``, ``movingBlocks``, ``unknowns`` (system size).
     Contacts: ``contactDistance`` [m] (d0 used), ``candidatePairs`` (block pairs
-    from the broad phase), ``contactPairs`` (pairs within d0), ``contacts``
+    from the broad phase), ``shells``, ``shellPairs`` (overlapping bounding
+    volumes), ``shellTests`` (volume comparisons), ``shellUpdates``,
+    ``subUnitPairs`` (vertex-face plus edge-edge pairs the candidates offer), ``contactPairs`` (pairs within d0), ``contacts``
     (vertex-face and edge-edge sub-contacts), ``closedContacts``,
     ``slidingContacts``, ``openCloseIterations`` (solves in the accepted
     attempt), ``openCloseIterationsTotal`` (in all attempts),

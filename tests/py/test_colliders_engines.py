@@ -99,16 +99,26 @@ def test_same_trajectories_with_every_strategy(scene):
         assert results[name] == reference, name
 
 
-def test_msc_collider_raises_clearly_while_unavailable(scene):
-    if 'MSC' in _engines._COLLIDERS:
-        engine = MSCCollider(criticalLength=2.0, segments=4)
-        assert engine.criticalLength == 2.0 and engine.segments == 4
-        assert "_select('MSC', criticalLength=2.0, segments=4)" in engine.command
-        return
-    with pytest.raises(NotImplementedError) as error:
-        MSCCollider(criticalLength=2.0, segments=4)
-    message = str(error.value)
-    assert 'multi-shell cover' in message and 'DESSCollider' in message
+def test_msc_engine_parameters_reach_the_core(scene):
+    """Slender 12 x 1 x 1 m logs: with segments=1 every block has one shell;
+    with segments=3 and the default critical length (3 x block size, about
+    6.9 m here) each log gets three, and MSC offers fewer sub-unit pairs to
+    the narrow phase than DESS for the same contacts."""
+    assert 'MSC' in _engines._COLLIDERS
+    logs = [(box((0, 1.05 * k, 0), (12, 1.05 * k + 1, 1)), k == 0) for k in range(6)]
+    logs += [(box((1.05 * k, 0, 1.01), (1.05 * k + 1, 12, 2.01)), False) for k in range(6)]
+    counts = {}
+    for name, engine in (('one', MSCCollider(segments=1)), ('three', MSCCollider(segments=3)),
+                         ('dess', DESSCollider())):
+        build(logs, [engine, integrator()])
+        O.run(2, True)
+        s = yade_dda.stats()
+        counts[name] = (s['shells'], s['subUnitPairs'], s['contacts'])
+    assert counts['one'][0] == 12 and counts['three'][0] == 36
+    assert counts['three'][2] == counts['dess'][2] == counts['one'][2]
+    assert counts['three'][1] < counts['dess'][1]
+    with pytest.raises(ValueError):
+        MSCCollider(segments=0)
 
 
 def test_msc_parameters_are_checked_and_stored(scene, monkeypatch):

@@ -2,7 +2,7 @@
 block counts, fixed counts, valid blocks, no initial penetration, and a few
 DDA steps without NaN.
 
-Geometry comes from examples/paper/scenes.py (pure Python); each scene is
+Geometry comes from examples/paper/paper_scenes.py (pure Python); each scene is
 built with ddaBlock and run for a few steps with the paper's step controls
 (dt 0.001 s, 0.01 m per step).
 """
@@ -16,7 +16,7 @@ from yade_dda import O, DDAIntegrator, ddaBlock, stats, block, contacts
 from yade import wrapper
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'examples', 'paper'))
-import scenes  # noqa: E402
+import paper_scenes as scenes  # noqa: E402
 
 G = 9.81
 

@@ -80,6 +80,11 @@ struct StepStatistics {
 	// contacts
 	double contactDistance = 0;      // d0 used [m]
 	long candidatePairs = 0;         // block pairs from the broad phase
+	long shellPairs = 0;             // overlapping bounding volumes (MSC: shell pairs)
+	long shellTests = 0;             // bounding-volume comparisons made
+	long shells = 0;                 // bounding volumes
+	long shellUpdates = 0;           // bounding volumes recomputed this step
+	long subUnitPairs = 0;           // vertex-face plus edge-edge sub-unit pairs the candidates offer
 	int contactPairs = 0;            // block pairs within d0
 	int contacts = 0;                // vertex-face and edge-edge sub-contacts
 	int closedContacts = 0;          // sliding or locked at the end of the step

@@ -196,6 +196,11 @@ void World::detectContacts(const IntegratorSettings& settings, StepStatistics& s
 	BroadPhaseStatistics broad;
 	collider_->findPairs(blocks_, stats.contactDistance, pairs_, broad);
 	stats.candidatePairs = broad.candidatePairs;
+	stats.shellPairs = broad.shellPairs;
+	stats.shellTests = broad.shellTests;
+	stats.shells = broad.shells;
+	stats.shellUpdates = broad.shellUpdates;
+	stats.subUnitPairs = broad.subUnitPairs;
 	stats.timeBroadPhase = secondsSince(phase);
 
 	phase = Clock::now();

@@ -5,7 +5,7 @@
 Pure Python (math only, no YADE), so the blocks can be built, checked or
 handed to another tool (a collider comparison, a plot) without a simulation::
 
-    import scenes
+    import paper_scenes as scenes
     blocks, material = scenes.hexahedra_drop(length=40)
     for vertices, fixed in blocks: ...
 
