@@ -56,8 +56,10 @@ def main(argv):
     parser.add_argument('--steps', type=int, default=100)
     parser.add_argument('--dt', type=float, default=1e-3, help='time step [s], the same for DDA and YADE')
     parser.add_argument('--young', type=float, default=1e9, help="Young's modulus [Pa]")
-    parser.add_argument('--out', default=os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'bench', 'out',
-                                                      'compare_colliders.json'))
+    # Relative to the current directory: under `yade -x` __file__ is YADE's own
+    # launcher, not this script.
+    parser.add_argument('--out', default=os.path.join('bench', 'out', 'compare_colliders.json'),
+                        help='JSON path (plots beside it), relative to the current directory')
     args, _ = parser.parse_known_args(argv)
     return compareColliders(lambda: slenderPile(args.blocks, args.length), steps=args.steps, dt=args.dt,
                             gravity=(0, 0, -9.81), young=args.young, poisson=0.25, density=2600,
