@@ -124,6 +124,14 @@ struct Prepared {
 	const EdgeData* edges = nullptr;
 	int faceTotal = 0;
 	Vector3 lower = Vector3::Zero(), upper = Vector3::Zero();  // bounding box [m]
+	const std::vector<char>* internalFaces = nullptr;
+
+	// A face covered by a coplanar face of a neighbouring fixed block: never an
+	// entrance, and its edges give no edge axes.
+	bool internal(int f) const { return internalFaces && (*internalFaces)[f]; }
+	bool internalEdge(int e) const {
+		return internalFaces && ((*internalFaces)[shape->edgeFaces[e][0]] || (*internalFaces)[shape->edgeFaces[e][1]]);
+	}
 
 	const Vector3& corner(int v) const { return (*vertices)[v]; }
 	int cornerCount() const { return static_cast<int>(vertices->size()); }
@@ -157,6 +165,7 @@ Prepared prepareBounds(const BlockGeometry& block) {
 	p.shape = block.shape;
 	p.vertices = block.vertices;
 	p.centroid = block.centroid;
+	p.internalFaces = block.internalFaces;
 	const std::vector<Vector3>& v = *block.vertices;
 	p.lower = p.upper = v.front();
 	for (const Vector3& x : v) {
@@ -513,13 +522,14 @@ void faceEntranceContacts(const Prepared& owner, bool ownerIsA, int f, const Pre
 		int bestFace = -1;
 		double bestDistance = -std::numeric_limits<double>::infinity();
 		for (int g = 0; g < other.faceCount(); ++g) {
+			if (other.internal(g)) continue;
 			const double d = planeDistance(other, g, x);
 			if (d > bestDistance) {
 				bestDistance = d;
 				bestFace = g;
 			}
 		}
-		if (bestDistance > reach) continue;
+		if (bestFace < 0 || bestDistance > reach) continue;
 		if (insideMargin(other, bestFace, x) < -reach) continue;
 		out.push_back(vertexFaceContact(ownerIsA, owner, q, other, bestFace));
 	}
@@ -663,15 +673,16 @@ std::optional<PairContacts> detectPairContacts(const BlockGeometry& blockA, cons
 	}
 	std::vector<FaceCandidate>& faces = s.candidates;
 	faces.clear();
+	// An internal face still rejects (its plane separates), but is no entrance.
 	for (int f = 0; f < a.faceCount(); ++f) {
 		const double sep = faceSeparation(a, f, b);
 		if (sep > d0) return std::nullopt;
-		faces.push_back({{EntranceFeature::FaceOfA, f, -1}, sep});
+		if (!a.internal(f)) faces.push_back({{EntranceFeature::FaceOfA, f, -1}, sep});
 	}
 	for (int f = 0; f < b.faceCount(); ++f) {
 		const double sep = faceSeparation(b, f, a);
 		if (sep > d0) return std::nullopt;
-		faces.push_back({{EntranceFeature::FaceOfB, f, -1}, sep});
+		if (!b.internal(f)) faces.push_back({{EntranceFeature::FaceOfB, f, -1}, sep});
 	}
 	double bestFace = -std::numeric_limits<double>::infinity();
 	for (const FaceCandidate& c : faces) bestFace = std::max(bestFace, c.separation);
@@ -682,7 +693,9 @@ std::optional<PairContacts> detectPairContacts(const BlockGeometry& blockA, cons
 	EdgeAxis bestEdge, previousEdge;
 	int bestEdgeA = -1, bestEdgeB = -1;
 	for (int ea = 0; ea < a.edgeCount(); ++ea) {
+		if (a.internalEdge(ea)) continue;
 		for (int eb = 0; eb < b.edgeCount(); ++eb) {
+			if (b.internalEdge(eb)) continue;
 			const EdgeAxis axis = edgeAxis(a, ea, b, eb, sinTolerance);
 			if (!axis.valid) continue;
 			if (axis.separation > d0) return std::nullopt;

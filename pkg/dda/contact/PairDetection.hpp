@@ -101,6 +101,13 @@ struct BlockGeometry {
 	const ConvexPolyhedron* shape = nullptr;       // faces, edges, edgeFaces
 	const std::vector<Vector3>* vertices = nullptr;  // current corners [m]
 	Vector3 centroid = Vector3::Zero();            // [m]
+	// Optional, per face: 1 for a face fully covered by a coplanar, opposed
+	// face of a neighbouring fixed block (a flush joint). Such a face is not
+	// a free surface: it still rejects pairs whose separation it proves, but
+	// is never an entrance face, and its edges give no edge axes. Without
+	// this, a block sliding across the joint meets the covered side face as a
+	// "ghost" obstacle.
+	const std::vector<char>* internalFaces = nullptr;
 };
 
 // Which feature is the pair's entrance feature (step 2).

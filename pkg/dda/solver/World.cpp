@@ -43,6 +43,70 @@ void requireFinite(const Vector3& v, const char* what) {
 		throw InputError(message.str());
 	}
 }
+// Corner x lies in the convex polygon `face` of `vertices` (normal n,
+// counter-clockwise seen from outside), within `tolerance` [m].
+bool insidePolygon(const Vector3& x, const std::vector<Vector3>& vertices, const std::vector<int>& face,
+                   const Vector3& n, double tolerance) {
+	for (std::size_t k = 0; k < face.size(); ++k) {
+		const Vector3& p = vertices[face[k]];
+		const Vector3& q = vertices[face[(k + 1) % face.size()]];
+		const Vector3 inward = n.cross(q - p);
+		const double length = inward.norm();
+		if (length > 0 && (x - p).dot(inward) < -tolerance * length) return false;
+	}
+	return true;
+}
+
+// Marks, for every fixed block, the faces fully covered by a coplanar,
+// opposed face of another fixed block (flush joints): see
+// BlockGeometry::internalFaces. Fixed blocks never move, so this runs only
+// when blocks are added. Pairs are found by sorting boxes along x.
+void markInternalFaces(const std::vector<Block>& blocks, std::vector<std::vector<char>>& internal) {
+	internal.assign(blocks.size(), {});
+	std::vector<int> fixed;
+	std::vector<Eigen::AlignedBox3d> boxes(blocks.size());
+	for (std::size_t b = 0; b < blocks.size(); ++b) {
+		if (!blocks[b].fixed) continue;
+		fixed.push_back(static_cast<int>(b));
+		internal[b].assign(blocks[b].shape->faces.size(), 0);
+		for (const Vector3& x : blocks[b].vertices) boxes[b].extend(x);
+	}
+	std::sort(fixed.begin(), fixed.end(), [&](int a, int b) { return boxes[a].min().x() < boxes[b].min().x(); });
+	for (std::size_t i = 0; i < fixed.size(); ++i) {
+		const int a = fixed[i];
+		for (std::size_t j = i + 1; j < fixed.size(); ++j) {
+			const int b = fixed[j];
+			const double tolerance =
+			    kDefaultRelativeLengthTolerance * std::max(boxes[a].diagonal().norm(), boxes[b].diagonal().norm());
+			if (boxes[b].min().x() > boxes[a].max().x() + tolerance) break;
+			Eigen::AlignedBox3d grown = boxes[a];
+			grown.min().array() -= tolerance;
+			grown.max().array() += tolerance;
+			if (!grown.intersects(boxes[b])) continue;
+			const Block& A = blocks[a];
+			const Block& B = blocks[b];
+			for (std::size_t f = 0; f < A.shape->faces.size(); ++f) {
+				const Vector3 nf = faceNormal(A.vertices, A.shape->faces[f]);
+				const Vector3& pf = A.vertices[A.shape->faces[f][0]];
+				for (std::size_t g = 0; g < B.shape->faces.size(); ++g) {
+					const Vector3 ng = faceNormal(B.vertices, B.shape->faces[g]);
+					if (nf.dot(ng) > -1 + kDefaultParallelAngleTolerance * kDefaultParallelAngleTolerance) continue;
+					bool coplanar = true;
+					for (int v : B.shape->faces[g]) coplanar = coplanar && std::abs(nf.dot(B.vertices[v] - pf)) <= tolerance;
+					if (!coplanar) continue;
+					bool fCovered = true, gCovered = true;
+					for (int v : A.shape->faces[f])
+						fCovered = fCovered && insidePolygon(A.vertices[v], B.vertices, B.shape->faces[g], ng, tolerance);
+					for (int v : B.shape->faces[g])
+						gCovered = gCovered && insidePolygon(B.vertices[v], A.vertices, A.shape->faces[f], nf, tolerance);
+					if (fCovered) internal[a][f] = 1;
+					if (gCovered) internal[b][g] = 1;
+				}
+			}
+		}
+	}
+}
+
 // Area [m^2] of the convex hull of the points projected on the plane
 // perpendicular to `normal` (Andrew's monotone chain, then the shoelace
 // formula); 0 for fewer than 3 points or collinear ones.
@@ -204,6 +268,10 @@ void World::detectContacts(const IntegratorSettings& settings, StepStatistics& s
 	stats.timeBroadPhase = secondsSince(phase);
 
 	phase = Clock::now();
+	if (internalFacesBlocks_ != blockCount()) {
+		markInternalFaces(blocks_, internalFaces_);
+		internalFacesBlocks_ = blockCount();
+	}
 	const int pairCount = static_cast<int>(pairs_.size());
 	pairResults_.assign(pairCount, std::nullopt);
 	std::vector<double> diagonal(blocks_.size());
@@ -229,8 +297,10 @@ void World::detectContacts(const IntegratorSettings& settings, StepStatistics& s
 		detection.angleTolerance = std::clamp(
 		    2 * stats.allowedDisplacement / std::min(diagonal[a], diagonal[b]), kDefaultParallelAngleTolerance,
 		    kMaxParallelAngleTolerance);
-		pairResults_[p] = detectPairContacts(BlockGeometry{A.shape.get(), &A.vertices, A.centroid},
-		                                     BlockGeometry{B.shape.get(), &B.vertices, B.centroid}, detection,
+		const std::vector<char>* internalA = internalFaces_[a].empty() ? nullptr : &internalFaces_[a];
+		const std::vector<char>* internalB = internalFaces_[b].empty() ? nullptr : &internalFaces_[b];
+		pairResults_[p] = detectPairContacts(BlockGeometry{A.shape.get(), &A.vertices, A.centroid, internalA},
+		                                     BlockGeometry{B.shape.get(), &B.vertices, B.centroid, internalB}, detection,
 		                                     store_.previousEntrance(a, b));
 	}
 	for (int p = 0; p < pairCount; ++p) {

@@ -61,6 +61,9 @@ private:
 	std::vector<const Block*> movingBlocks_;
 	std::vector<BlockMotion> motions_;
 	std::vector<const SubContact*> accepted_;
+	// Faces of fixed blocks covered by a flush neighbour (BlockGeometry::internalFaces).
+	std::vector<std::vector<char>> internalFaces_;
+	int internalFacesBlocks_ = -1;  // block count when internalFaces_ was computed
 	std::vector<Vector3> points_;
 	std::vector<Block> blocks_;
 	StepStatistics stats_;

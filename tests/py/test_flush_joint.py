@@ -1,20 +1,16 @@
-"""Known defects, kept as strict expected failures so that they stay visible and
-the fix is noticed (a strict xfail fails once the defect is gone).
+"""Flush joints between fixed blocks: a block sliding without friction from one
+fixed block onto a second one laid flush against it (coplanar tops) keeps its
+kinetic energy.
 
-Flush joint between fixed blocks: a block sliding without friction from one
-fixed block onto a second one laid flush against it (coplanar tops) should
-keep its kinetic energy. Today it loses most of it (61% with these numbers) once its front
-reaches the joint: for the new pair, while the front is still short of the
-joint, the separating axis is the second block's side face at the joint,
-which is an internal face of the flush pair (covered by the first block), so
-the pair's contacts push the block back horizontally ("ghost" contact of an
-internal edge). The fix under consideration: mark faces of fixed blocks that
-are fully covered by a coplanar face of another fixed block as internal and
-never use them as entrance faces.
+While the block's front is still short of the joint, the pair's separating
+axis is the second block's side face at the joint; that face is covered by
+the first block (an internal face of the flush pair). Used as an entrance it
+pushed the block back horizontally, a "ghost" obstacle that took 61% of the
+kinetic energy here. The engine now marks faces of fixed blocks fully
+covered by a coplanar face of another fixed block as internal and never
+enters through them (BlockGeometry::internalFaces).
 """
 import math
-
-import pytest
 
 import yade_dda
 from yade_dda import O, DDAIntegrator, ddaBlock
@@ -25,7 +21,6 @@ from helpers import box
 G = 9.81
 
 
-@pytest.mark.xfail(strict=True, raises=AssertionError, reason='ghost contact on the internal face of a flush joint between fixed blocks')
 def test_frictionless_block_crosses_a_flush_joint_keeping_its_energy(scene):
     rock = O.materials.append(wrapper.PolyhedraMat(density=2600, young=1e9, poisson=0.25, frictionAngle=0))
     O.bodies.append(ddaBlock(box((-10, -3, -1), (8, 3, 0)), material=rock, fixed=True))
