@@ -13,6 +13,7 @@
 #include "dda/contact/Distance.hpp"
 #include "dda/contact/Linearization.hpp"
 #include "dda/contact/PairDetection.hpp"
+#include "dda/geometry/MassProperties.hpp"
 #include "dda/geometry/ConvexPolyhedron.hpp"
 
 #include <Eigen/Geometry>
@@ -873,3 +874,47 @@ TEST(ContactDetection, RandomBoxesAndTetrahedraNearContact) {
 }
 
 }  // namespace
+
+// Two turned logs side by side (from the paper's hexahedra drop, step 1128):
+// the second log's corners sit 36 um below the first one's bottom face (so
+// they are outside it), while the first log's bottom edge cuts 0.36 mm into
+// the second log's side face. The crossings beside those corners push along
+// x, the corners' contacts along z: the crossings must stay. Dropping them
+// (an earlier corner-merge rule) left the pair without any penetrating
+// sub-contact, and the logs sank 0.4 m into each other.
+TEST(ContactDetection, OverlapOfTurnedLogsIsRepresentedByASubContact) {
+	const std::vector<Vector3> log1 = {
+	    {-8.3516706442490012, -10.179903089140623, 4.9194987463906799},
+	    {-7.3429838252272628, -10.179903087473122, 4.9195251681233065},
+	    {-8.3516706709854169, 10.179903087526171, 4.9194987460755577},
+	    {-7.3429838519636945, 10.179903089193679, 4.9195251678081915},
+	    {-8.3627267086338062, -10.179903089148144, 5.8742626195503655},
+	    {-7.3540398896120767, -10.179903087480636, 5.8742890412829993},
+	    {-8.3627267353702557, 10.179903087518657, 5.8742626192352541},
+	    {-7.3540399163485244, 10.179903089186158, 5.8742890409678807}};
+	const std::vector<Vector3> log2 = {
+	    {-7.3433389635284092, -10.089161232484551, 4.919489375338407},
+	    {-6.3311287341299289, -10.089161232483221, 4.9194999010976979},
+	    {-7.343338964201207, 10.089161232481519, 4.9194893750150754},
+	    {-6.3311287348027223, 10.08916123248285, 4.9194999007743618},
+	    {-7.3477794472388203, -10.089161232482263, 5.8742659030389301},
+	    {-6.3355692178403356, -10.089161232480933, 5.8742764287982165},
+	    {-7.3477794479116136, 10.089161232483807, 5.8742659027155941},
+	    {-6.3355692185131334, 10.089161232485138, 5.874276428474885}};
+	const dda::ConvexPolyhedron a = dda::buildConvexPolyhedron(log1), b = dda::buildConvexPolyhedron(log2);
+	const Vector3 ca = dda::computeMassProperties(a.vertices, a.faces).centroid;
+	const Vector3 cb = dda::computeMassProperties(b.vertices, b.faces).centroid;
+	DetectionSettings settings;
+	settings.contactDistance = 0.025;
+	settings.lengthTolerance = 2e-7;
+	settings.hysteresis = 0.0025;
+	settings.cornerMergeDistance = 0.02;  // 1e-3 x the logs' diagonal, as World sets it
+	settings.angleTolerance = 1e-3;
+	const auto result = dda::detectPairContacts(dda::BlockGeometry{&a, &a.vertices, ca}, dda::BlockGeometry{&b, &b.vertices, cb},
+	                                            settings);
+	ASSERT_TRUE(result.has_value());
+	ASSERT_LT(result->separation, -3e-4);  // they overlap by 0.36 mm
+	double deepest = 0;
+	for (const SubContact& c : result->contacts) deepest = std::min(deepest, c.gap);
+	EXPECT_LT(deepest, 0.9 * result->separation) << "no sub-contact carries the overlap";
+}

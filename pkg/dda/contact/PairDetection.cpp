@@ -25,6 +25,10 @@ using ExactVector = Kernel::Vector_3;
 // and far below kDefaultRelativeLengthTolerance (1e-8).
 constexpr double kRoundoffRelative = 1e-12;
 
+// A crossing beside a vertex contact is that contact only if their normals
+// are within about 25 degrees (dimensionless cosine).
+constexpr double kSameNormalCosine = 0.9;
+
 // Two face areas within this fraction of each other tie (dimensionless), so
 // identical blocks are ordered by block and face index, not by round-off.
 // Rule: above the round-off of an area (~1e-15), below any real difference.
@@ -474,10 +478,15 @@ std::optional<SubContact> edgeEdgeContact(bool firstIsA, const Prepared& blockI,
 	return c;
 }
 
-// An edge-edge contact within `merge` [m] of the point of a vertex-face contact.
+// An edge-edge contact within `merge` [m] of the point of a vertex-face contact
+// that pushes the same way (normals within acos(kSameNormalCosine)); a
+// crossing whose normal differs is a different contact, even beside a corner
+// (two turned logs side by side: a corner just below the other log's bottom
+// face, an edge crossing into its side face).
 bool besideVertexContact(const SubContact& crossing, const std::vector<SubContact>& found, double merge) {
 	for (const SubContact& other : found) {
 		if (other.kind != ContactKind::VertexFace) continue;
+		if (std::abs(other.normal.dot(crossing.normal)) < kSameNormalCosine) continue;
 		if ((other.pointI - crossing.pointI).norm() <= merge || (other.pointI - crossing.pointJ).norm() <= merge)
 			return true;
 	}

@@ -49,9 +49,11 @@
 //          2 x (the entrance's penetration) + d0: an edge piercing F steeply
 //          near F's boundary has its line distance in F's plane and would
 //          push sideways by an unrelated depth; and not within
-//          cornerMergeDistance of a vertex-face contact above (offset squares
-//          cross each other's edges right beside a corner that already has
-//          its contact; a crossing next to a corner with no contact stays).
+//          cornerMergeDistance of a vertex-face contact above whose normal
+//          is within ~25 degrees of its own (offset squares cross each
+//          other's edges right beside a corner that already has its contact;
+//          a crossing next to a corner with no contact, or pushing another
+//          way, stays).
 //      An edge entrance gives one edge-edge sub-contact (block i = A), or
 //      falls back to the best face when the two edges do not cross strictly
 //      inside. Edge-edge stencils take as reference direction (from block i
