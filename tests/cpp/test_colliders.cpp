@@ -5,6 +5,7 @@
 #include "dda/collider/Collider.hpp"
 #include "dda/contact/PairDetection.hpp"
 #include "dda/solver/World.hpp"
+#include "TestScenes.hpp"
 
 #include <gtest/gtest.h>
 
@@ -16,48 +17,9 @@
 #include <tuple>
 
 using namespace dda;
+using namespace dda::testing;
 
 namespace {
-
-std::vector<Vector3> orientedBox(const Vector3& centre, const Vector3& half, const Eigen::Matrix3d& R) {
-	std::vector<Vector3> points;
-	for (int i = 0; i < 8; ++i) {
-		const Vector3 local((i & 1 ? 1 : -1) * half.x(), (i & 2 ? 1 : -1) * half.y(), (i & 4 ? 1 : -1) * half.z());
-		points.push_back(centre + R * local);
-	}
-	return points;
-}
-
-// n blocks: slender (up to 30:1, 15 m long) and compact boxes, randomly turned, packed so
-// that many touch or nearly touch; some fixed; a few exact corner-to-corner and
-// edge-to-edge placements.
-World randomScene(int n, unsigned seed) {
-	std::mt19937 rng(seed);
-	std::uniform_real_distribution<double> unit(0, 1);
-	World world;
-	Material material;
-	for (int k = 0; k < n; ++k) {
-		const double length = unit(rng) < 0.5 ? 1 + 14 * unit(rng) : 1 + unit(rng);
-		const Vector3 half(0.5 * length, 0.25 + 0.25 * unit(rng), 0.25 + 0.25 * unit(rng));
-		const Vector3 axis = Vector3(unit(rng) - 0.5, unit(rng) - 0.5, unit(rng) - 0.5).normalized();
-		const Eigen::Matrix3d R = Eigen::AngleAxisd(3.2 * unit(rng), axis).toRotationMatrix();
-		const Vector3 centre(25 * unit(rng), 25 * unit(rng), 25 * unit(rng));
-		world.addBlock(orientedBox(centre, half, R), material, unit(rng) < 0.3);
-	}
-	// Exact placements: unit cubes corner on corner and edge on edge.
-	const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
-	world.addBlock(orientedBox(Vector3(30, 0, 0), Vector3(0.5, 0.5, 0.5), I), material, false);
-	world.addBlock(orientedBox(Vector3(31, 1, 1), Vector3(0.5, 0.5, 0.5), I), material, false);
-	world.addBlock(orientedBox(Vector3(30, 3, 0), Vector3(0.5, 0.5, 0.5), I), material, true);
-	world.addBlock(orientedBox(Vector3(31, 3, 1), Vector3(0.5, 0.5, 0.5), I), material, false);
-	return world;
-}
-
-std::vector<Block> blocksOf(const World& world) {
-	std::vector<Block> blocks;
-	for (int i = 0; i < world.blockCount(); ++i) blocks.push_back(world.block(i));
-	return blocks;
-}
 
 // The contact set: every sub-contact (pair, kind, owner, features) found.
 using ContactSet = std::set<std::tuple<int, int, int, bool, int, int>>;

@@ -6,6 +6,7 @@
 #include "dda/collider/MSCCollider.hpp"
 #include "dda/contact/PairDetection.hpp"
 #include "dda/solver/World.hpp"
+#include "TestScenes.hpp"
 
 #include <gtest/gtest.h>
 
@@ -19,44 +20,16 @@
 #include <tuple>
 
 using namespace dda;
+using namespace dda::testing;
 
 namespace {
 
-std::vector<Vector3> orientedBox(const Vector3& centre, const Vector3& half, const Eigen::Matrix3d& R) {
-	std::vector<Vector3> points;
-	for (int i = 0; i < 8; ++i) {
-		const Vector3 local((i & 1 ? 1 : -1) * half.x(), (i & 2 ? 1 : -1) * half.y(), (i & 4 ? 1 : -1) * half.z());
-		points.push_back(centre + R * local);
-	}
-	return points;
-}
-
-Eigen::Matrix3d randomRotation(std::mt19937& rng) {
-	std::uniform_real_distribution<double> unit(0, 1);
-	const Vector3 axis = Vector3(unit(rng) - 0.5, unit(rng) - 0.5, unit(rng) - 0.5).normalized();
-	return Eigen::AngleAxisd(3.2 * unit(rng), axis).toRotationMatrix();
-}
-
-// As in test_colliders.cpp: slender (up to 30:1, 15 m long) and compact boxes,
-// randomly turned, packed so that many touch or overlap; some fixed; exact
-// corner-to-corner and edge-to-edge placements.
-World randomScene(int n, unsigned seed) {
-	std::mt19937 rng(seed);
-	std::uniform_real_distribution<double> unit(0, 1);
-	World world;
+// TestScenes.hpp's random scene, plus a long block with cubes lying along
+// its edge, exactly on its slab planes.
+World randomMscScene(int n, unsigned seed) {
+	World world = randomScene(n, seed);
 	Material material;
-	for (int k = 0; k < n; ++k) {
-		const double length = unit(rng) < 0.5 ? 1 + 14 * unit(rng) : 1 + unit(rng);
-		const Vector3 half(0.5 * length, 0.25 + 0.25 * unit(rng), 0.25 + 0.25 * unit(rng));
-		const Eigen::Matrix3d R = randomRotation(rng);
-		const Vector3 centre(25 * unit(rng), 25 * unit(rng), 25 * unit(rng));
-		world.addBlock(orientedBox(centre, half, R), material, unit(rng) < 0.3);
-	}
 	const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
-	world.addBlock(orientedBox(Vector3(30, 0, 0), Vector3(0.5, 0.5, 0.5), I), material, false);
-	world.addBlock(orientedBox(Vector3(31, 1, 1), Vector3(0.5, 0.5, 0.5), I), material, false);
-	world.addBlock(orientedBox(Vector3(30, 3, 0), Vector3(0.5, 0.5, 0.5), I), material, true);
-	world.addBlock(orientedBox(Vector3(31, 3, 1), Vector3(0.5, 0.5, 0.5), I), material, false);
 	// A long block lying along the edge of another, exactly: the contact sits
 	// on the first one's slab planes.
 	world.addBlock(orientedBox(Vector3(40, 0, 0), Vector3(10, 0.5, 0.5), I), material, false);
@@ -89,12 +62,6 @@ World logPile(double d0, unsigned seed) {
 		z += 1 + gap();
 	}
 	return world;
-}
-
-std::vector<Block> blocksOf(const World& world) {
-	std::vector<Block> blocks;
-	for (int i = 0; i < world.blockCount(); ++i) blocks.push_back(world.block(i));
-	return blocks;
 }
 
 DetectionSettings detection(double d0) {
@@ -205,7 +172,7 @@ bool inShells(const MSCCollider& msc, int block, const Vector3& x, double tolera
 
 TEST(MSCCollider, FindsTheAllPairsContactSet) {
 	for (unsigned seed : {1u, 2u, 3u, 4u}) {
-		const std::vector<Block> blocks = blocksOf(randomScene(120, seed));
+		const std::vector<Block> blocks = blocksOf(randomMscScene(120, seed));
 		for (double d0 : {0.0, 0.05, 0.5}) {
 			AllPairsCollider all;
 			const ContactSet reference = contactSet(all, blocks, d0);
@@ -228,7 +195,7 @@ TEST(MSCCollider, LinksEveryFeatureOfTheContacts) {
 	int checked = 0;
 	for (unsigned seed : {1u, 2u, 3u})
 		for (double d0 : {0.0, 0.05, 0.5}) {
-			const std::vector<Block> blocks = blocksOf(randomScene(120, seed));
+			const std::vector<Block> blocks = blocksOf(randomMscScene(120, seed));
 			checked += checkLinkedFeatures(blocks, d0);
 			checkLinkedFeatures(blocks, d0, MSCCollider(0.5, 7));  // every block cut, in 7
 		}
@@ -292,7 +259,7 @@ TEST(MSCCollider, FewerCandidatesAndSubUnitLoopsThanDESSOnSlenderScenes) {
 }
 
 TEST(MSCCollider, ShellsCoverTheirBlocksAlsoAfterAffineMotion) {
-	std::vector<Block> blocks = blocksOf(randomScene(60, 5));
+	std::vector<Block> blocks = blocksOf(randomMscScene(60, 5));
 	// One block of its own cover: 9 slabs from 1 m long.
 	MSCCollider msc;
 	msc.setBlockCover(0, 1.0, 9);
@@ -341,7 +308,7 @@ TEST(MSCCollider, ShellsCoverTheirBlocksAlsoAfterAffineMotion) {
 }
 
 TEST(MSCCollider, FixedBlocksShellsAreBuiltOnceAndFixedPairsNeverProposed) {
-	const std::vector<Block> blocks = blocksOf(randomScene(100, 9));
+	const std::vector<Block> blocks = blocksOf(randomMscScene(100, 9));
 	MSCCollider msc;
 	long fixedShells = 0, allShells = 0;
 	std::vector<std::pair<int, int>> pairs;
@@ -383,7 +350,7 @@ TEST(MSCCollider, FixedBlocksShellsAreBuiltOnceAndFixedPairsNeverProposed) {
 }
 
 TEST(MSCCollider, StatisticsAndLinkedSetsOfEveryStrategy) {
-	const std::vector<Block> blocks = blocksOf(randomScene(80, 4));
+	const std::vector<Block> blocks = blocksOf(randomMscScene(80, 4));
 	std::unique_ptr<Collider> others[] = {std::make_unique<AllPairsCollider>(), std::make_unique<DESSCollider>(),
 	                                      std::make_unique<NBSCollider>()};
 	for (auto& collider : others) {
@@ -432,7 +399,7 @@ TEST(MSCCollider, RejectsInvalidCovers) {
 }
 
 TEST(MSCCollider, SceneAndBlockCoversRebuildOnlyWhatChanged) {
-	const std::vector<Block> blocks = blocksOf(randomScene(40, 6));
+	const std::vector<Block> blocks = blocksOf(randomMscScene(40, 6));
 	const int n = static_cast<int>(blocks.size());
 	MSCCollider msc;
 	std::vector<std::pair<int, int>> pairs, first;

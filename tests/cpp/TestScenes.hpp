@@ -1,0 +1,59 @@
+// Scene builders shared by the broad-phase tests (test_colliders.cpp,
+// test_msc.cpp): oriented boxes and a random scene of slender and compact,
+// turned, fixed and free blocks with a few exact placements.
+#pragma once
+
+#include "dda/solver/World.hpp"
+
+#include <Eigen/Geometry>
+
+#include <random>
+#include <vector>
+
+namespace dda::testing {
+
+inline std::vector<Vector3> orientedBox(const Vector3& centre, const Vector3& half, const Eigen::Matrix3d& R) {
+	std::vector<Vector3> points;
+	for (int i = 0; i < 8; ++i) {
+		const Vector3 local((i & 1 ? 1 : -1) * half.x(), (i & 2 ? 1 : -1) * half.y(), (i & 4 ? 1 : -1) * half.z());
+		points.push_back(centre + R * local);
+	}
+	return points;
+}
+
+inline Eigen::Matrix3d randomRotation(std::mt19937& rng) {
+	std::uniform_real_distribution<double> unit(0, 1);
+	const Vector3 axis = Vector3(unit(rng) - 0.5, unit(rng) - 0.5, unit(rng) - 0.5).normalized();
+	return Eigen::AngleAxisd(3.2 * unit(rng), axis).toRotationMatrix();
+}
+
+// n blocks: slender (up to 15:1, 15 m long) and compact boxes, randomly
+// turned, in a 25 m cube so that many touch or nearly touch; about 30% fixed;
+// then unit cubes exactly corner on corner and edge on edge.
+inline World randomScene(int n, unsigned seed) {
+	std::mt19937 rng(seed);
+	std::uniform_real_distribution<double> unit(0, 1);
+	World world;
+	Material material;
+	for (int k = 0; k < n; ++k) {
+		const double length = unit(rng) < 0.5 ? 1 + 14 * unit(rng) : 1 + unit(rng);
+		const Vector3 half(0.5 * length, 0.25 + 0.25 * unit(rng), 0.25 + 0.25 * unit(rng));
+		const Eigen::Matrix3d R = randomRotation(rng);
+		const Vector3 centre(25 * unit(rng), 25 * unit(rng), 25 * unit(rng));
+		world.addBlock(orientedBox(centre, half, R), material, unit(rng) < 0.3);
+	}
+	const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+	world.addBlock(orientedBox(Vector3(30, 0, 0), Vector3(0.5, 0.5, 0.5), I), material, false);
+	world.addBlock(orientedBox(Vector3(31, 1, 1), Vector3(0.5, 0.5, 0.5), I), material, false);
+	world.addBlock(orientedBox(Vector3(30, 3, 0), Vector3(0.5, 0.5, 0.5), I), material, true);
+	world.addBlock(orientedBox(Vector3(31, 3, 1), Vector3(0.5, 0.5, 0.5), I), material, false);
+	return world;
+}
+
+inline std::vector<Block> blocksOf(const World& world) {
+	std::vector<Block> blocks;
+	for (int i = 0; i < world.blockCount(); ++i) blocks.push_back(world.block(i));
+	return blocks;
+}
+
+}  // namespace dda::testing
