@@ -18,7 +18,7 @@ carries every parameter, so an engine that comes back from
 from ._yade import O, wrapper
 from . import engines as _engines
 from . import scene as _scene
-from .engines import _Parameter, _finite
+from .engines import _Parameter, _finite, _initEngine
 
 _COMMAND = 'import yade_dda.colliders as _ddac; _ddac._select('
 
@@ -67,20 +67,7 @@ class _ColliderEngine(wrapper.PyRunner):
 
     def __init__(self, label='', **params):
         wrapper.PyRunner.__init__(self)
-        unknown = set(params) - set(self._names)
-        if unknown:
-            raise TypeError('%s has no parameter %s%s' % (
-                type(self).__name__, ', '.join(sorted(unknown)),
-                ' (parameters: %s)' % ', '.join(self._names) if self._names else ' (it takes none but label)'))
-        self._params = {}
-        for name in self._names:
-            descriptor = type(self).__dict__[name]
-            self._params[name] = descriptor.check(params.get(name, descriptor.default))
-        self.iterPeriod = 1
-        self.initRun = True
-        if label:
-            self.label = label
-        self._updateCommand()
+        _initEngine(self, label, params)
 
     @property
     def strategy(self):
@@ -95,7 +82,7 @@ class _ColliderEngine(wrapper.PyRunner):
 class DESSCollider(_ColliderEngine):
     """DESS broad phase for DDA blocks (replaces InsertionSortCollider).
 
-    Double-ended spheres-and-boxes sort (Perkins & Williams 2001): each block's
+    Double-ended spatial sorting (Perkins & Williams 2001): each block's
     axis-aligned box, widened by the contact distance d0 [m] on every side, is
     sorted by its lower end along the axis on which the blocks spread most and
     swept up to its upper end; pairs whose boxes overlap on all three axes

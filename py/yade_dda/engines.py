@@ -57,6 +57,27 @@ def _colliderName(value):
     return value
 
 
+def _initEngine(engine, label, params):
+    """Checks and stores an engine's typed parameters (its class's ``_names``,
+    each a _Parameter), runs it every step from the first, sets the label and
+    writes the command. Unknown names raise TypeError naming them."""
+    names = type(engine)._names
+    unknown = set(params) - set(names)
+    if unknown:
+        raise TypeError('%s has no parameter %s%s' % (
+            type(engine).__name__, ', '.join(sorted(unknown)),
+            ' (parameters: %s)' % ', '.join(names) if names else ' (it takes none but label)'))
+    engine._params = {}
+    for name in names:
+        descriptor = type(engine).__dict__[name]
+        engine._params[name] = descriptor.check(params.get(name, descriptor.default))
+    engine.iterPeriod = 1
+    engine.initRun = True
+    if label:
+        engine.label = label
+    engine._updateCommand()
+
+
 def _vector3(name):
     return lambda value: _vector(value, name)
 
@@ -107,8 +128,10 @@ class DDAIntegrator(wrapper.PyRunner):
       converge (0.3).
     - ``openCloseTolerance`` [-]: a closed contact opens when its gap exceeds
       this x the allowed step displacement (1e-9).
-    - ``collider``: the broad phase, ``'DESS'`` (one sorted box per block,
-      default), ``'NBS'`` (one bounding sphere per block, binned in cells) or
+    - ``collider``: the broad phase, ``'MSC'`` (multi-shell cover, with its
+      default cover; use ``MSCCollider`` to set lambda and N), ``'DESS'`` (one
+      sorted box per block, default), ``'NBS'`` (one bounding sphere per
+      block, binned in cells) or
       ``'AllPairs'`` (every pair: the reference, O(n^2)). All give the same
       contacts; only the time differs. A collider engine before the
       integrator (``DESSCollider``, ``NBSCollider``, ...) overrides it.
@@ -147,7 +170,8 @@ class DDAIntegrator(wrapper.PyRunner):
     openCloseShrink = _Parameter(0.3, lambda v: _finite('openCloseShrink', v, 0, 0.99, lowOpen=True),
                                  'dt factor when the open-close iteration does not converge [-]')
     collider = _Parameter('DESS', lambda v: _colliderName(v),
-                          "broad phase: 'DESS' (sorted boxes, default), 'NBS' (binned spheres) or 'AllPairs' (every pair, the oracle)")
+                          "broad phase: 'MSC' (multi-shell cover), 'DESS' (sorted boxes, default), 'NBS' (binned spheres) or "
+                          "'AllPairs' (every pair, the oracle)")
     openCloseTolerance = _Parameter(1e-9, lambda v: _finite('openCloseTolerance', v, 0),
                                     'opening gap of a closed contact / allowed step displacement [-]')
 
@@ -158,19 +182,7 @@ class DDAIntegrator(wrapper.PyRunner):
 
     def __init__(self, label='', **params):
         wrapper.PyRunner.__init__(self)
-        unknown = set(params) - set(self._names)
-        if unknown:
-            raise TypeError('DDAIntegrator has no parameter %s (parameters: %s)'
-                            % (', '.join(sorted(unknown)), ', '.join(self._names)))
-        self._params = {}
-        for name in self._names:
-            descriptor = type(self).__dict__[name]
-            self._params[name] = descriptor.check(params.get(name, descriptor.default))
-        self.iterPeriod = 1
-        self.initRun = True
-        if label:
-            self.label = label
-        self._updateCommand()
+        _initEngine(self, label, params)
 
     @classmethod
     def _defaults(cls):
