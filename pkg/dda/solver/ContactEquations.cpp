@@ -38,6 +38,20 @@ void close(Contact& contact) {
 	trial.slidingDirection.setZero();
 }
 
+// The shear spring's stretch: where block i's anchor ends minus where block j's does [m].
+Vector3 anchorSeparation(const ContactHistory& trial, const Block& blockI, const Block& blockJ, const Vector12& Di,
+                         const Vector12& Dj) {
+	return (trial.anchorI + displacementAt(trial.anchorI - blockI.centroid, Di)) -
+	       (trial.anchorJ + displacementAt(trial.anchorJ - blockJ.centroid, Dj));
+}
+
+// Normal force of a closed contact at linearised gap `gap` [N]: compressive
+// > 0; tension only while bonded.
+double normalForce(const Contact& contact, double gap) {
+	const double force = -contact.normalStiffness * gap;
+	return contact.trial.bonded ? force : std::max(0.0, force);
+}
+
 }  // namespace
 
 void prepareContact(Contact& contact, const Block& blockI, const Block& blockJ, const IntegratorSettings& settings) {
@@ -117,8 +131,7 @@ bool updateContactState(Contact& contact, const Block& blockI, const Block& bloc
 		trial.normalForce = 0;
 		return before != trial.state;
 	}
-	trial.normalForce = -contact.normalStiffness * gap;
-	if (!trial.bonded) trial.normalForce = std::max(0.0, trial.normalForce);
+	trial.normalForce = normalForce(contact, gap);
 	if (!canLock(contact)) {
 		trial.state = ContactState::Sliding;
 		return before != trial.state;
@@ -130,8 +143,7 @@ bool updateContactState(Contact& contact, const Block& blockI, const Block& bloc
 	if (!trial.bonded && trial.normalForce <= 0) return before != trial.state;
 	const Matrix3 P = tangentProjector(n);
 	if (trial.state == ContactState::Locked) {
-		const Vector3 delta = (trial.anchorI + displacementAt(trial.anchorI - blockI.centroid, Di)) -
-		                      (trial.anchorJ + displacementAt(trial.anchorJ - blockJ.centroid, Dj));
+		const Vector3 delta = anchorSeparation(trial, blockI, blockJ, Di, Dj);
 		const Vector3 shear = P * delta;
 		const double shearNorm = shear.norm();
 		const double strength = contact.frictionTangent * std::max(0.0, trial.normalForce) +
@@ -164,12 +176,10 @@ void finishContact(Contact& contact, const Block& blockI, const Block& blockJ, c
 		return;
 	}
 	const double gap = contactGap(contact, Di, Dj);
-	trial.normalForce = -contact.normalStiffness * gap;
-	if (!trial.bonded) trial.normalForce = std::max(0.0, trial.normalForce);
+	trial.normalForce = normalForce(contact, gap);
 	const Matrix3 P = tangentProjector(contact.geometry.normal);
 	if (trial.state == ContactState::Locked) {
-		const Vector3 delta = (trial.anchorI + displacementAt(trial.anchorI - blockI.centroid, Di)) -
-		                      (trial.anchorJ + displacementAt(trial.anchorJ - blockJ.centroid, Dj));
+		const Vector3 delta = anchorSeparation(trial, blockI, blockJ, Di, Dj);
 		trial.shearForce = -contact.shearStiffness * (P * delta);
 	} else {
 		trial.shearForce = -contact.frictionTangent * trial.normalForce * trial.slidingDirection;
