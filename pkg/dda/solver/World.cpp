@@ -274,7 +274,8 @@ void World::detectContacts(const IntegratorSettings& settings, StepStatistics& s
 	}
 	const int pairCount = static_cast<int>(pairs_.size());
 	pairResults_.assign(pairCount, std::nullopt);
-	std::vector<double> diagonal(blocks_.size());
+	std::vector<double>& diagonal = diagonals_;
+	diagonal.resize(blocks_.size());
 	for (std::size_t b = 0; b < blocks_.size(); ++b) {
 		Eigen::AlignedBox3d box;
 		for (const Vector3& x : blocks_[b].vertices) box.extend(x);

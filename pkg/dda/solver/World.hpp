@@ -61,6 +61,7 @@ private:
 	std::vector<const Block*> movingBlocks_;
 	std::vector<BlockMotion> motions_;
 	std::vector<const SubContact*> accepted_;
+	std::vector<double> diagonals_;  // per block, bounding-box diagonal of this step [m]
 	// Faces of fixed blocks covered by a flush neighbour (BlockGeometry::internalFaces).
 	std::vector<std::vector<char>> internalFaces_;
 	int internalFacesBlocks_ = -1;  // block count when internalFaces_ was computed
