@@ -310,16 +310,15 @@ void World::detectContacts(const IntegratorSettings& settings, StepStatistics& s
 		const PairContacts& pair = *pairResults_[p];
 		++stats.contactPairs;
 		store_.setEntrance(a, b, pair.entrance);
-		accepted_.clear();
-		for (const SubContact& sub : pair.contacts) accepted_.push_back(&sub);
 		// The pair's contact area, shared by its sub-contacts (bond strengths).
 		points_.clear();
-		for (const SubContact* sub : accepted_) points_.push_back(sub->pointJ);
-		const double area = accepted_.empty() ? 0.0 : projectedHullArea(points_, pair.normal) / accepted_.size();
-		for (const SubContact* sub : accepted_) {
-			const int i = sub->firstIsA ? a : b, j = sub->firstIsA ? b : a;
-			const ContactKey key{i, j, sub->kind, sub->feature1, sub->feature2};
-			Contact& contact = store_.add(key, pair.type, *sub, *blocks_[i].shape, *blocks_[j].shape);
+		for (const SubContact& sub : pair.contacts) points_.push_back(sub.pointJ);
+		const double area =
+		    pair.contacts.empty() ? 0.0 : projectedHullArea(points_, pair.normal) / pair.contacts.size();
+		for (const SubContact& sub : pair.contacts) {
+			const int i = sub.firstIsA ? a : b, j = sub.firstIsA ? b : a;
+			const ContactKey key{i, j, sub.kind, sub.feature1, sub.feature2};
+			Contact& contact = store_.add(key, pair.type, sub, *blocks_[i].shape, *blocks_[j].shape);
 			contact.area = area;
 			prepareContact(contact, blocks_[i], blocks_[j], settings);
 		}

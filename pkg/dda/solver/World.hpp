@@ -60,7 +60,6 @@ private:
 	std::vector<int> movingIndex_;  // block -> index in moving_, -1 for fixed blocks
 	std::vector<const Block*> movingBlocks_;
 	std::vector<BlockMotion> motions_;
-	std::vector<const SubContact*> accepted_;
 	std::vector<double> diagonals_;  // per block, bounding-box diagonal of this step [m]
 	// Faces of fixed blocks covered by a flush neighbour (BlockGeometry::internalFaces).
 	std::vector<std::vector<char>> internalFaces_;
