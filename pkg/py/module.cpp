@@ -231,6 +231,8 @@ py::dict lastStep(const SceneLink& s) {
 	d["shells"] = st.shells;
 	d["shellUpdates"] = st.shellUpdates;
 	d["subUnitPairs"] = st.subUnitPairs;
+	d["subUnitTests"] = st.subUnitTests;
+	d["fullSearchPairs"] = st.fullSearchPairs;
 	d["contactPairs"] = st.contactPairs;
 	d["contacts"] = st.contacts;
 	d["closedContacts"] = st.closedContacts;

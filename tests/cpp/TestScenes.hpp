@@ -1,13 +1,21 @@
 // Scene builders shared by the broad-phase tests (test_colliders.cpp,
 // test_msc.cpp): oriented boxes and a random scene of slender and compact,
-// turned, fixed and free blocks with a few exact placements.
+// turned, fixed and free blocks with a few exact placements; and the contact
+// set a broad phase plus the narrow phase find.
 #pragma once
 
+#include "dda/collider/Collider.hpp"
+#include "dda/contact/PairDetection.hpp"
 #include "dda/solver/World.hpp"
+
+#include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <random>
+#include <set>
+#include <tuple>
 #include <vector>
 
 namespace dda::testing {
@@ -54,6 +62,48 @@ inline std::vector<Block> blocksOf(const World& world) {
 	std::vector<Block> blocks;
 	for (int i = 0; i < world.blockCount(); ++i) blocks.push_back(world.block(i));
 	return blocks;
+}
+
+// What a broad phase and the narrow phase find: per pair within d0 its
+// structural type and entrance feature, (a, b, -1, type, entrance kind,
+// entrance feature x 1000 + other), and every sub-contact, (a, b, kind,
+// block i is a, feature 1, feature 2).
+using ContactSet = std::set<std::tuple<int, int, int, int, int, int>>;
+
+inline DetectionSettings detectionSettings(double d0) {
+	DetectionSettings settings;
+	settings.contactDistance = d0;
+	settings.lengthTolerance = 1e-9;
+	return settings;
+}
+
+// The narrow phase runs on the sub-units the collider links to each pair
+// (MSC), or on all (the others). `work` sums the narrow phase's work.
+inline ContactSet contactSet(Collider& collider, const std::vector<Block>& blocks, double d0,
+                             BroadPhaseStatistics* statsOut = nullptr, NarrowPhaseWork* work = nullptr) {
+	std::vector<std::pair<int, int>> pairs;
+	BroadPhaseStatistics stats;
+	collider.findPairs(blocks, d0, pairs, stats);
+	EXPECT_TRUE(std::is_sorted(pairs.begin(), pairs.end()));
+	EXPECT_TRUE(std::adjacent_find(pairs.begin(), pairs.end()) == pairs.end()) << "pairs are unique";
+	EXPECT_EQ(stats.candidatePairs, static_cast<long>(pairs.size()));
+	if (statsOut) *statsOut = stats;
+	ContactSet out;
+	for (int p = 0; p < static_cast<int>(pairs.size()); ++p) {
+		const auto [a, b] = pairs[p];
+		EXPECT_LT(a, b);
+		EXPECT_FALSE(blocks[a].fixed && blocks[b].fixed);
+		const auto result =
+		    detectPairContacts(BlockGeometry{blocks[a].shape.get(), &blocks[a].vertices, blocks[a].centroid},
+		                       BlockGeometry{blocks[b].shape.get(), &blocks[b].vertices, blocks[b].centroid},
+		                       detectionSettings(d0), {}, collider.linked(p), work);
+		if (!result) continue;
+		out.insert({a, b, -1, static_cast<int>(result->type), static_cast<int>(result->entrance.kind),
+		            1000 * result->entrance.feature + result->entrance.other});
+		for (const SubContact& c : result->contacts)
+			out.insert({a, b, static_cast<int>(c.kind), c.firstIsA, c.feature1, c.feature2});
+	}
+	return out;
 }
 
 }  // namespace dda::testing

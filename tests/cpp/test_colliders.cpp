@@ -21,29 +21,11 @@ using namespace dda::testing;
 
 namespace {
 
-// The contact set: every sub-contact (pair, kind, owner, features) found.
-using ContactSet = std::set<std::tuple<int, int, int, bool, int, int>>;
-
-ContactSet contactSet(Collider& collider, const std::vector<Block>& blocks, double d0, long* candidates = nullptr) {
-	std::vector<std::pair<int, int>> pairs;
+// The contact set (TestScenes.hpp), with the candidate count.
+ContactSet contactSet(Collider& collider, const std::vector<Block>& blocks, double d0, long* candidates) {
 	BroadPhaseStatistics stats;
-	collider.findPairs(blocks, d0, pairs, stats);
-	EXPECT_TRUE(std::is_sorted(pairs.begin(), pairs.end()));
-	if (candidates) *candidates = stats.candidatePairs;
-	ContactSet out;
-	for (auto [a, b] : pairs) {
-		EXPECT_LT(a, b);
-		EXPECT_FALSE(blocks[a].fixed && blocks[b].fixed);
-		DetectionSettings settings;
-		settings.contactDistance = d0;
-		settings.lengthTolerance = 1e-9;
-		const auto result = detectPairContacts(BlockGeometry{blocks[a].shape.get(), &blocks[a].vertices, blocks[a].centroid},
-		                                       BlockGeometry{blocks[b].shape.get(), &blocks[b].vertices, blocks[b].centroid},
-		                                       settings);
-		if (!result) continue;
-		for (const SubContact& c : result->contacts)
-			out.insert({a, b, static_cast<int>(c.kind), c.firstIsA, c.feature1, c.feature2});
-	}
+	ContactSet out = dda::testing::contactSet(collider, blocks, d0, &stats);
+	*candidates = stats.candidatePairs;
 	return out;
 }
 

@@ -64,40 +64,10 @@ World logPile(double d0, unsigned seed) {
 	return world;
 }
 
-DetectionSettings detection(double d0) {
-	DetectionSettings settings;
-	settings.contactDistance = d0;
-	settings.lengthTolerance = 1e-9;
-	return settings;
-}
-
 std::optional<PairContacts> detect(const std::vector<Block>& blocks, int a, int b, double d0) {
 	return detectPairContacts(BlockGeometry{blocks[a].shape.get(), &blocks[a].vertices, blocks[a].centroid},
 	                          BlockGeometry{blocks[b].shape.get(), &blocks[b].vertices, blocks[b].centroid},
-	                          detection(d0));
-}
-
-using ContactSet = std::set<std::tuple<int, int, int, bool, int, int>>;
-
-ContactSet contactSet(Collider& collider, const std::vector<Block>& blocks, double d0,
-                      BroadPhaseStatistics* statsOut = nullptr) {
-	std::vector<std::pair<int, int>> pairs;
-	BroadPhaseStatistics stats;
-	collider.findPairs(blocks, d0, pairs, stats);
-	EXPECT_TRUE(std::is_sorted(pairs.begin(), pairs.end()));
-	EXPECT_TRUE(std::adjacent_find(pairs.begin(), pairs.end()) == pairs.end()) << "pairs are unique";
-	EXPECT_EQ(stats.candidatePairs, static_cast<long>(pairs.size()));
-	if (statsOut) *statsOut = stats;
-	ContactSet out;
-	for (auto [a, b] : pairs) {
-		EXPECT_LT(a, b);
-		EXPECT_FALSE(blocks[a].fixed && blocks[b].fixed);
-		const auto result = detect(blocks, a, b, d0);
-		if (!result) continue;
-		for (const SubContact& c : result->contacts)
-			out.insert({a, b, static_cast<int>(c.kind), c.firstIsA, c.feature1, c.feature2});
-	}
-	return out;
+	                          detectionSettings(d0));
 }
 
 bool has(const std::vector<int>& sorted, int x) { return std::binary_search(sorted.begin(), sorted.end(), x); }
@@ -234,11 +204,15 @@ TEST(MSCCollider, FewerCandidatesAndSubUnitLoopsThanDESSOnSlenderScenes) {
 			DESSCollider dess;
 			MSCCollider msc;
 			BroadPhaseStatistics allStats, dessStats, mscStats;
+			NarrowPhaseWork dessWork, mscWork;
 			const ContactSet reference = contactSet(all, blocks, d0, &allStats);
-			EXPECT_TRUE(contactSet(dess, blocks, d0, &dessStats) == reference);
-			EXPECT_TRUE(contactSet(msc, blocks, d0, &mscStats) == reference);
+			EXPECT_TRUE(contactSet(dess, blocks, d0, &dessStats, &dessWork) == reference);
+			EXPECT_TRUE(contactSet(msc, blocks, d0, &mscStats, &mscWork) == reference);
 			EXPECT_LE(mscStats.candidatePairs, dessStats.candidatePairs) << "d0 " << d0;
 			EXPECT_LT(mscStats.subUnitPairs, dessStats.subUnitPairs) << "d0 " << d0;
+			// The narrow phase really loops over the linked sub-units only.
+			EXPECT_LT(mscWork.subUnitTests, dessWork.subUnitTests) << "d0 " << d0;
+			EXPECT_EQ(dessWork.fullSearches, 0);
 			EXPECT_GE(mscStats.shellPairs, mscStats.candidatePairs);
 			EXPECT_EQ(mscStats.shells, 3L * world->blockCount());  // every block is long
 			EXPECT_EQ(dessStats.shells, world->blockCount());
@@ -461,4 +435,35 @@ TEST(MSCCollider, WorldStepsAsWithDESS) {
 	for (std::size_t b = 0; b < withDess.size(); ++b)
 		for (std::size_t v = 0; v < withDess[b].vertices.size(); ++v)
 			EXPECT_EQ(withDess[b].vertices[v], withMsc[b].vertices[v]) << "block " << b << " corner " << v;
+}
+
+TEST(MSCCollider, LinkedNarrowPhaseEqualsTheFullSearchAndFallsBackWhenDeep) {
+	// Log piles keep DDA's range of penetration (down to -0.4 d0): the linked
+	// search alone decides every pair, with fewer tests than on all sub-units.
+	for (unsigned seed : {1u, 2u, 3u})
+		for (double d0 : {0.01, 0.1}) {
+			const std::vector<Block> blocks = blocksOf(logPile(d0, seed));
+			AllPairsCollider all;
+			MSCCollider msc, fine(3, 9);
+			NarrowPhaseWork allWork, mscWork, fineWork;
+			const ContactSet reference = contactSet(all, blocks, d0, nullptr, &allWork);
+			ASSERT_GT(reference.size(), 50u);
+			EXPECT_TRUE(contactSet(msc, blocks, d0, nullptr, &mscWork) == reference) << seed << " " << d0;
+			EXPECT_TRUE(contactSet(fine, blocks, d0, nullptr, &fineWork) == reference) << seed << " " << d0;
+			EXPECT_EQ(mscWork.fullSearches, 0);
+			EXPECT_EQ(fineWork.fullSearches, 0);
+			EXPECT_LT(mscWork.subUnitTests, allWork.subUnitTests);
+		}
+	// Random scenes overlap deeply (blocks placed at random): those pairs are
+	// searched again with every sub-unit, and the result is still the same.
+	long fullSearches = 0;
+	for (unsigned seed : {1u, 2u}) {
+		const std::vector<Block> blocks = blocksOf(randomMscScene(120, seed));
+		AllPairsCollider all;
+		MSCCollider msc;
+		NarrowPhaseWork work;
+		EXPECT_TRUE(contactSet(msc, blocks, 0.05, nullptr, &work) == contactSet(all, blocks, 0.05)) << seed;
+		fullSearches += work.fullSearches;
+	}
+	EXPECT_GT(fullSearches, 0);
 }

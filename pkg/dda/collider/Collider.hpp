@@ -7,10 +7,10 @@
 #pragma once
 
 #include "dda/block/Block.hpp"
+#include "dda/contact/SubUnits.hpp"
 
 #include <Eigen/Geometry>
 
-#include <array>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -37,25 +37,6 @@ struct BroadPhaseStatistics {
 	// sub-units of the overlapping shells; other strategies: all of them).
 	long subUnitPairs = 0;
 };
-
-// The sub-units (vertices, edges, faces: indices into the blocks' shapes) a
-// broad phase links to one candidate pair (a, b): [0] of block a, [1] of
-// block b, each sorted and unique.
-struct LinkedSubUnits {
-	std::array<std::vector<int>, 2> vertices, edges, faces;
-	long subUnitPairs() const {
-		const auto n = [](const std::vector<int>& v) { return static_cast<long>(v.size()); };
-		return n(vertices[0]) * n(faces[1]) + n(vertices[1]) * n(faces[0]) + n(edges[0]) * n(edges[1]);
-	}
-};
-
-// The sub-unit loops of a pair when every sub-unit takes part.
-inline long allSubUnitPairs(const ConvexPolyhedron& a, const ConvexPolyhedron& b) {
-	const auto v = [](const ConvexPolyhedron& s) { return static_cast<long>(s.vertices.size()); };
-	const auto e = [](const ConvexPolyhedron& s) { return static_cast<long>(s.edges.size()); };
-	const auto f = [](const ConvexPolyhedron& s) { return static_cast<long>(s.faces.size()); };
-	return v(a) * f(b) + v(b) * f(a) + e(a) * e(b);
-}
 
 class Collider {
 public:

@@ -9,7 +9,8 @@
 // Why the linked sub-units hold every feature of a pair's contacts. A
 // vertex-face contact P -> F has P within reach = d0 + lengthTolerance of F's
 // plane (or penetrating by at most delta, the pair's depth) and P's projection
-// within reach of F, so P is within sqrt(2) max(reach, delta) of a point q of F.
+// within reach of F (a distance to the polygon, also near its acute corners),
+// so P is within sqrt(2) max(reach, delta) of a point q of F.
 // P lies in a slice of its block, q in a slice of the other; those slices'
 // shells link P and F (a feature is linked to every slab it touches), and
 // their boxes, widened by d0 + w each, overlap whenever every coordinate of

@@ -12,7 +12,9 @@
 // pair is a candidate when two of its shells overlap. Where the paper lets the
 // nearest shell decide, a pair here links the union of its overlapping shells'
 // sub-units, each once: every feature of its contacts while penetration stays
-// below d0 / 2 (argued in the .cpp; tested also on deep random overlaps).
+// below d0 / 2 (argued in the .cpp). The narrow phase (detectPairContacts with
+// the linked sets) loops over those only and searches a deeper pair again
+// with every sub-unit, so its contacts are exactly the full search's.
 #pragma once
 
 #include "Collider.hpp"

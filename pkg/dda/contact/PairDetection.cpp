@@ -106,14 +106,25 @@ struct Scratch {
 	std::vector<EdgeData> edges[2];
 	std::vector<FaceCandidate> candidates;
 	std::vector<double> cornerDistances;
+	std::vector<char> cornerDistanceReady;
 	std::vector<int> used, faceEdges;
 	std::vector<Vector3> pointsA, pointsB;
+	std::vector<int> identity;  // 0, 1, 2, ...: "every sub-unit"
+	std::vector<char> vertexLinked[2], edgeLinked[2];
 };
 
 Scratch& scratch() {
 	thread_local Scratch s;
 	return s;
 }
+
+// A list of sub-unit indices (linked ones, or all of them).
+struct Indices {
+	const int* first = nullptr;
+	int count = 0;
+	const int* begin() const { return first; }
+	const int* end() const { return first + count; }
+};
 
 // A block with the per-call data the narrow phase needs.
 struct Prepared {
@@ -129,6 +140,15 @@ struct Prepared {
 	int faceTotal = 0;
 	Vector3 lower = Vector3::Zero(), upper = Vector3::Zero();  // bounding box [m]
 	const std::vector<char>* internalFaces = nullptr;
+	// The sub-units the narrow phase may use (all, or those a broad phase
+	// linked to the pair), and per corner and edge whether it is one of them.
+	Indices vertexList, edgeList, faceList;
+	const char* vertexLinked = nullptr;  // nullptr: every corner
+	const char* edgeLinked = nullptr;    // nullptr: every edge
+	long* tests = nullptr;               // vertex-face and edge-edge tests made
+
+	bool linkedVertex(int v) const { return !vertexLinked || vertexLinked[v]; }
+	bool linkedEdge(int e) const { return !edgeLinked || edgeLinked[e]; }
 
 	// A face covered by a coplanar face of a neighbouring fixed block: never an
 	// entrance, and its edges give no edge axes.
@@ -209,16 +229,17 @@ void ensurePlane(const Prepared& p, int f) {
 	p.planeReady[f] = 1;
 }
 
-// Edge data (after prepareFaces).
+// Edge data of the edges the pair may use (after prepareSubUnits).
 void prepareEdges(Prepared& p, Scratch& s, int slot) {
 	std::vector<EdgeData>& edges = s.edges[slot];
-	const int count = p.edgeCount();
-	edges.resize(count);
-	for (int e = 0; e < count; ++e) {
+	edges.resize(p.edgeCount());
+	for (int e : p.edgeList) {
 		EdgeData& d = edges[e];
 		d.direction = p.edgeEnd(e) - p.edgeStart(e);
 		d.length = d.direction.norm();
 		const auto& ef = p.shape->edgeFaces[e];
+		ensurePlane(p, ef[0]);
+		ensurePlane(p, ef[1]);
 		d.arc = p.faces[ef[1]].normal.cross(p.faces[ef[0]].normal);
 	}
 	p.edges = edges.data();
@@ -258,6 +279,31 @@ double insideMargin(const Prepared& block, int f, const Vector3& x) {
 		margin = std::min(margin, inward.dot(x - a) / length);
 	}
 	return margin;
+}
+
+double segmentDistance(const Vector3& x, const Vector3& p, const Vector3& q) {
+	const Vector3 d = q - p;
+	const double dd = d.squaredNorm();
+	const double s = dd > 0 ? std::clamp(d.dot(x - p) / dd, 0.0, 1.0) : 0.0;
+	return (x - (p + s * d)).norm();
+}
+
+// Does x's projection on the plane of face f lie within `reach` [m] of the
+// polygon? (A corner just past a face's edge or corner makes a contact with
+// it; measured as a distance, not per edge line, so that near an acute corner
+// of the face, too, the corner is within sqrt(2) reach of the face.)
+bool projectionNearFace(const Prepared& block, int f, const Vector3& x, double reach) {
+	const double margin = insideMargin(block, f, x);
+	if (margin >= 0) return true;
+	if (margin < -reach) return false;
+	const std::vector<int>& face = block.shape->faces[f];
+	const Vector3& n = block.faces[f].normal;
+	const Vector3 projected = x - n * n.dot(x - block.corner(face[0]));
+	double nearest = std::numeric_limits<double>::infinity();
+	for (std::size_t k = 0; k < face.size(); ++k)
+		nearest = std::min(nearest, segmentDistance(projected, block.corner(face[k]),
+		                                            block.corner(face[(k + 1) % face.size()])));
+	return nearest <= reach;
 }
 
 // Two edge directions are parallel: exactly (cross product of the double
@@ -317,6 +363,7 @@ bool arcsCross(const Prepared& a, int ea, const Prepared& b, int eb) {
 double faceSeparation(const Prepared& owner, int f, const Prepared& other) {
 	if (owner.separationReady[f]) return owner.separations[f];
 	ensurePlane(owner, f);
+	*owner.tests += other.cornerCount();
 	double separation = std::numeric_limits<double>::infinity();
 	for (int v = 0; v < other.cornerCount(); ++v)
 		separation = std::min(separation, planeDistance(owner, f, other.corner(v)));
@@ -331,7 +378,7 @@ int likelySeparatingFace(const Prepared& owner, const Vector3& direction) {
 	const std::vector<Vector3>& v = *owner.vertices;
 	int best = -1;
 	double bestScore = -std::numeric_limits<double>::infinity();
-	for (int f = 0; f < owner.faceCount(); ++f) {
+	for (int f : owner.faceList) {
 		const std::vector<int>& face = owner.shape->faces[f];
 		const Vector3& f0 = v[face[0]];
 		const Vector3 n = (v[face[1]] - f0).cross(v[face[2]] - f0);
@@ -502,16 +549,27 @@ void faceEntranceContacts(const Prepared& owner, bool ownerIsA, int f, const Pre
 	// a corner touching a face may lie that far off the face's triangle plane.
 	const double reach = settings.contactDistance + settings.lengthTolerance;
 
+	// The other block's corners' distances from the face's plane, each
+	// computed when first needed.
+	std::vector<double>& distances = s.cornerDistances;
+	std::vector<char>& ready = s.cornerDistanceReady;
+	distances.resize(other.cornerCount());
+	ready.assign(other.cornerCount(), 0);
+	const auto distance = [&](int v) {
+		if (!ready[v]) {
+			distances[v] = planeDistance(owner, f, other.corner(v));
+			ready[v] = 1;
+			++*owner.tests;
+		}
+		return distances[v];
+	};
+
 	// Corners of the other block on the face.
-	std::vector<double>& distance = s.cornerDistances;  // from the face's plane
-	distance.resize(other.cornerCount());
 	std::vector<int>& used = s.used;
 	used.clear();
-	for (int v = 0; v < other.cornerCount(); ++v) {
-		const Vector3& p = other.corner(v);
-		distance[v] = planeDistance(owner, f, p);
-		if (distance[v] > reach) continue;
-		if (insideMargin(owner, f, p) < -reach) continue;
+	for (int v : other.vertexList) {
+		if (distance(v) > reach) continue;
+		if (!projectionNearFace(owner, f, other.corner(v), reach)) continue;
 		out.push_back(vertexFaceContact(!ownerIsA, other, v, owner, f));
 		used.push_back(v);
 	}
@@ -519,6 +577,7 @@ void faceEntranceContacts(const Prepared& owner, bool ownerIsA, int f, const Pre
 	// Corners of the face near the other block, against their own entrance face.
 	const double merge = std::max(settings.cornerMergeDistance, settings.lengthTolerance);
 	for (int q : owner.shape->faces[f]) {
+		if (!owner.linkedVertex(q)) continue;
 		const Vector3& x = owner.corner(q);
 		bool coincident = false;  // with a corner used above
 		for (int v : used) {
@@ -532,6 +591,8 @@ void faceEntranceContacts(const Prepared& owner, bool ownerIsA, int f, const Pre
 		double bestDistance = -std::numeric_limits<double>::infinity();
 		for (int g = 0; g < other.faceCount(); ++g) {
 			if (other.internal(g)) continue;
+			++*owner.tests;
+			ensurePlane(other, g);
 			const double d = planeDistance(other, g, x);
 			if (d > bestDistance) {
 				bestDistance = d;
@@ -539,7 +600,7 @@ void faceEntranceContacts(const Prepared& owner, bool ownerIsA, int f, const Pre
 			}
 		}
 		if (bestFace < 0 || bestDistance > reach) continue;
-		if (insideMargin(other, bestFace, x) < -reach) continue;
+		if (!projectionNearFace(other, bestFace, x, reach)) continue;
 		out.push_back(vertexFaceContact(ownerIsA, owner, q, other, bestFace));
 	}
 
@@ -547,7 +608,7 @@ void faceEntranceContacts(const Prepared& owner, bool ownerIsA, int f, const Pre
 	const double deepest = kEdgePenetrationFactor * std::min(separation, 0.0) - reach;
 	std::vector<int>& faceEdges = s.faceEdges;
 	faceEdges.clear();
-	for (int e = 0; e < owner.edgeCount(); ++e) {
+	for (int e : owner.edgeList) {
 		const auto& ef = owner.shape->edgeFaces[e];
 		if (ef[0] == f || ef[1] == f) faceEdges.push_back(e);
 	}
@@ -561,10 +622,11 @@ void faceEntranceContacts(const Prepared& owner, bool ownerIsA, int f, const Pre
 	limits.direction = &owner.faces[f].normal;
 	limits.minCosine = kEdgeNormalMinCosine;
 	const auto& otherEdges = other.shape->edges;
-	for (int e = 0; e < other.edgeCount(); ++e) {
-		const double low = std::min(distance[otherEdges[e][0]], distance[otherEdges[e][1]]);
+	for (int e : other.edgeList) {
+		const double low = std::min(distance(otherEdges[e][0]), distance(otherEdges[e][1]));
 		if (low > reach) continue;
 		for (int g : faceEdges) {
+			++*owner.tests;
 			std::optional<SubContact> c =
 			    edgeEdgeContact(!ownerIsA, other, e, owner, g, settings, sinTolerance, limits);
 			if (!c) continue;
@@ -582,13 +644,6 @@ struct Feature {
 	FeatureKind kind = FeatureKind::Face;
 	int index = -1;  // corner (Vertex) or edge (Edge)
 };
-
-double segmentDistance(const Vector3& x, const Vector3& p, const Vector3& q) {
-	const Vector3 d = q - p;
-	const double dd = d.squaredNorm();
-	const double s = dd > 0 ? std::clamp(d.dot(x - p) / dd, 0.0, 1.0) : 0.0;
-	return (x - (p + s * d)).norm();
-}
 
 // The smallest feature of `block` within `tolerance` [m] of all the points: one
 // corner, else one edge, else a face.
@@ -640,6 +695,44 @@ void supportCorners(const Prepared& block, const Vector3& direction, double tole
 		if (direction.dot(block.corner(v)) >= extreme - tolerance) out.push_back(block.corner(v));
 }
 
+// Makes s.identity hold 0 .. n - 1 at least, for both blocks of a pair before
+// either's lists point into it.
+void ensureIdentity(Scratch& s, const Prepared& a, const Prepared& b) {
+	const int largest = std::max({a.cornerCount(), a.edgeCount(), a.faceCount(), b.cornerCount(), b.edgeCount(),
+	                              b.faceCount()});
+	std::vector<int>& identity = s.identity;
+	if (static_cast<int>(identity.size()) >= largest) return;
+	identity.resize(largest);
+	for (int i = 0; i < largest; ++i) identity[i] = i;
+}
+
+// The sub-units block `p` (slot 0: A, 1: B) offers the pair: the linked ones,
+// or all (after ensureIdentity). Also points p.tests at the pair's counter.
+void prepareSubUnits(Prepared& p, const LinkedSubUnits* linked, int slot, Scratch& s, long& tests) {
+	p.tests = &tests;
+	const int corners = p.cornerCount(), edges = p.edgeCount(), faces = p.faceCount();
+	const std::vector<int>& identity = s.identity;
+	if (!linked) {
+		p.vertexList = {identity.data(), corners};
+		p.edgeList = {identity.data(), edges};
+		p.faceList = {identity.data(), faces};
+		p.vertexLinked = p.edgeLinked = nullptr;
+		return;
+	}
+	const auto list = [](const std::vector<int>& v) { return Indices{v.data(), static_cast<int>(v.size())}; };
+	p.vertexList = list(linked->vertices[slot]);
+	p.edgeList = list(linked->edges[slot]);
+	p.faceList = list(linked->faces[slot]);
+	std::vector<char>& vertexMark = s.vertexLinked[slot];
+	vertexMark.assign(corners, 0);
+	for (int v : linked->vertices[slot]) vertexMark[v] = 1;
+	std::vector<char>& edgeMark = s.edgeLinked[slot];
+	edgeMark.assign(edges, 0);
+	for (int e : linked->edges[slot]) edgeMark[e] = 1;
+	p.vertexLinked = vertexMark.data();
+	p.edgeLinked = edgeMark.data();
+}
+
 }  // namespace
 
 const char* contactTypeName(ContactType type) {
@@ -656,8 +749,12 @@ const char* contactTypeName(ContactType type) {
 }
 
 std::optional<PairContacts> detectPairContacts(const BlockGeometry& blockA, const BlockGeometry& blockB,
-                                               const DetectionSettings& settings, const EntranceFeature& previous) {
+                                               const DetectionSettings& settings, const EntranceFeature& previous,
+                                               const LinkedSubUnits* linked, NarrowPhaseWork* work) {
 	const double d0 = settings.contactDistance, tol = settings.lengthTolerance;
+	NarrowPhaseWork ownWork;
+	if (!work) work = &ownWork;
+	long& tests = work->subUnitTests;
 
 	// Bounding boxes widened by d0.
 	Prepared a = prepareBounds(blockA);
@@ -668,6 +765,9 @@ std::optional<PairContacts> detectPairContacts(const BlockGeometry& blockA, cons
 	Scratch& s = scratch();
 	prepareFaces(a, s, 0);
 	prepareFaces(b, s, 1);
+	ensureIdentity(s, a, b);
+	prepareSubUnits(a, linked, 0, s, tests);
+	prepareSubUnits(b, linked, 1, s, tests);
 	const double sinTolerance = std::sin(settings.angleTolerance);
 
 	// 1. Face axes, stopping at the first one farther than d0. Any axis
@@ -682,15 +782,20 @@ std::optional<PairContacts> detectPairContacts(const BlockGeometry& blockA, cons
 	}
 	std::vector<FaceCandidate>& faces = s.candidates;
 	faces.clear();
+	// Largest separation over every axis tested, internal faces included: minus
+	// the pair's penetration depth, or less.
+	double deepestBound = -std::numeric_limits<double>::infinity();
 	// An internal face still rejects (its plane separates), but is no entrance.
-	for (int f = 0; f < a.faceCount(); ++f) {
+	for (int f : a.faceList) {
 		const double sep = faceSeparation(a, f, b);
 		if (sep > d0) return std::nullopt;
+		deepestBound = std::max(deepestBound, sep);
 		if (!a.internal(f)) faces.push_back({{EntranceFeature::FaceOfA, f, -1}, sep});
 	}
-	for (int f = 0; f < b.faceCount(); ++f) {
+	for (int f : b.faceList) {
 		const double sep = faceSeparation(b, f, a);
 		if (sep > d0) return std::nullopt;
+		deepestBound = std::max(deepestBound, sep);
 		if (!b.internal(f)) faces.push_back({{EntranceFeature::FaceOfB, f, -1}, sep});
 	}
 	double bestFace = -std::numeric_limits<double>::infinity();
@@ -701,13 +806,15 @@ std::optional<PairContacts> detectPairContacts(const BlockGeometry& blockA, cons
 	prepareEdges(b, s, 1);
 	EdgeAxis bestEdge, previousEdge;
 	int bestEdgeA = -1, bestEdgeB = -1;
-	for (int ea = 0; ea < a.edgeCount(); ++ea) {
+	for (int ea : a.edgeList) {
 		if (a.internalEdge(ea)) continue;
-		for (int eb = 0; eb < b.edgeCount(); ++eb) {
+		for (int eb : b.edgeList) {
 			if (b.internalEdge(eb)) continue;
+			++tests;
 			const EdgeAxis axis = edgeAxis(a, ea, b, eb, sinTolerance);
 			if (!axis.valid) continue;
 			if (axis.separation > d0) return std::nullopt;
+			deepestBound = std::max(deepestBound, axis.separation);
 			if (previous.kind == EntranceFeature::EdgePair && previous.feature == ea && previous.other == eb)
 				previousEdge = axis;
 			if (!bestEdge.valid || axis.separation > bestEdge.separation) {
@@ -718,6 +825,14 @@ std::optional<PairContacts> detectPairContacts(const BlockGeometry& blockA, cons
 		}
 	}
 	const double best = bestEdge.valid ? std::max(bestFace, bestEdge.separation) : bestFace;
+	// Linked sub-units hold every contact feature while the pair penetrates by
+	// at most d0 / 2; the linked axes bound the depth from above (the full
+	// search's best axis separates at least as much), so a deeper bound sends
+	// the pair to the full search.
+	if (linked && !(deepestBound >= -0.5 * d0)) {
+		++work->fullSearches;
+		return detectPairContacts(blockA, blockB, settings, previous, nullptr, work);
+	}
 
 	// 2. The entrance feature.
 	const double hysteresis = std::max(settings.hysteresis, tol);

@@ -32,12 +32,12 @@
 //      may lie that far off its triangle's plane). A face entrance F of block
 //      R, normal n, entered by the other block I gives
 //        - vertex-face F <- P for each corner P of I within d0 of F's plane
-//          whose projection lies in F widened by d0 (a corner just past F's
+//          whose projection lies within d0 of F (a corner just past F's
 //          edge or corner is a vertex-edge or vertex-vertex contact, entered
 //          through F);
 //        - vertex-face G <- Q for each corner Q of F within d0 of I, G the
 //          face of I of largest signed distance of Q (Q's own entrance face),
-//          Q's projection in G widened by d0, and Q not within
+//          Q's projection within d0 of G, and Q not within
 //          cornerMergeDistance of a corner P already used (corners that
 //          coincide, to round-off or to the small strains of the blocks
 //          since they met, give one contact, not two opposed ones);
@@ -79,6 +79,7 @@
 
 #include "Distance.hpp"
 #include "Linearization.hpp"
+#include "SubUnits.hpp"
 #include "dda/geometry/ConvexPolyhedron.hpp"
 
 #include <optional>
@@ -171,8 +172,26 @@ struct PairContacts {
 // settings.contactDistance. `previous` is the pair's entrance feature of the
 // last step (None when new). Never returns NaN; throws nothing for valid
 // blocks of buildConvexPolyhedron.
+//
+// `linked` (optional): the sub-units a broad phase linked to the pair (MSC).
+// Then only linked faces give face axes, only linked edge pairs give edge
+// axes, and only linked corners and edges make sub-contacts; a face axis still
+// measures all of the other block's corners (a middle slab of a log has no
+// corner of its own, and a separation from part of a block would reject
+// pairs that touch). Each feature of a contact within d0 lies within
+// sqrt(2) (d0 + lengthTolerance) of the other block, so it is linked when the
+// pair penetrates by at most d0 / 2 (MSCCollider.cpp gives the bound); a pair
+// whose linked axes show a deeper penetration is searched again with every
+// sub-unit. The result equals the unrestricted search's (tested on every step
+// of random, slender and paper scenes).
+// `work` (optional) is increased by what the call did.
+struct NarrowPhaseWork {
+	long subUnitTests = 0;  // vertex-face plane tests plus edge-edge tests
+	long fullSearches = 0;  // linked pairs searched again with every sub-unit
+};
 std::optional<PairContacts> detectPairContacts(const BlockGeometry& a, const BlockGeometry& b,
                                                const DetectionSettings& settings,
-                                               const EntranceFeature& previous = {});
+                                               const EntranceFeature& previous = {},
+                                               const LinkedSubUnits* linked = nullptr, NarrowPhaseWork* work = nullptr);
 
 }  // namespace dda

@@ -85,6 +85,8 @@ struct StepStatistics {
 	long shells = 0;                 // bounding volumes
 	long shellUpdates = 0;           // bounding volumes recomputed this step
 	long subUnitPairs = 0;           // vertex-face plus edge-edge sub-unit pairs the candidates offer
+	long subUnitTests = 0;           // vertex-face plane tests and edge-edge tests the narrow phase made
+	long fullSearchPairs = 0;        // MSC pairs searched again with every sub-unit (deep penetration)
 	int contactPairs = 0;            // block pairs within d0
 	int contacts = 0;                // vertex-face and edge-edge sub-contacts
 	int closedContacts = 0;          // sliding or locked at the end of the step

@@ -274,6 +274,7 @@ void World::detectContacts(const IntegratorSettings& settings, StepStatistics& s
 	}
 	const int pairCount = static_cast<int>(pairs_.size());
 	pairResults_.assign(pairCount, std::nullopt);
+	pairWork_.assign(pairCount, NarrowPhaseWork{});
 	std::vector<double>& diagonal = diagonals_;
 	diagonal.resize(blocks_.size());
 	for (std::size_t b = 0; b < blocks_.size(); ++b) {
@@ -302,9 +303,11 @@ void World::detectContacts(const IntegratorSettings& settings, StepStatistics& s
 		const std::vector<char>* internalB = internalFaces_[b].empty() ? nullptr : &internalFaces_[b];
 		pairResults_[p] = detectPairContacts(BlockGeometry{A.shape.get(), &A.vertices, A.centroid, internalA},
 		                                     BlockGeometry{B.shape.get(), &B.vertices, B.centroid, internalB}, detection,
-		                                     store_.previousEntrance(a, b));
+		                                     store_.previousEntrance(a, b), collider_->linked(p), &pairWork_[p]);
 	}
 	for (int p = 0; p < pairCount; ++p) {
+		stats.subUnitTests += pairWork_[p].subUnitTests;
+		stats.fullSearchPairs += pairWork_[p].fullSearches;
 		if (!pairResults_[p]) continue;
 		const auto [a, b] = pairs_[p];
 		const PairContacts& pair = *pairResults_[p];

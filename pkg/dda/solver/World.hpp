@@ -57,6 +57,7 @@ private:
 	long openCloseFailures_ = 0;
 	std::vector<std::pair<int, int>> pairs_;
 	std::vector<std::optional<PairContacts>> pairResults_;
+	std::vector<NarrowPhaseWork> pairWork_;  // per candidate pair
 	std::vector<int> movingIndex_;  // block -> index in moving_, -1 for fixed blocks
 	std::vector<const Block*> movingBlocks_;
 	std::vector<BlockMotion> motions_;
