@@ -28,6 +28,8 @@ install: build
 
 demo: install
 	yade -n -x examples/demo.py
+	yade -n -x examples/paper/hexahedra_drop.py --collider MSC --steps 400
+	yade -n -x examples/compare_colliders.py --scene hexahedra_drop --steps 300
 
 test: install
 	cd $(BUILD) && ctest --output-on-failure

@@ -8,7 +8,12 @@ of the DDA core's broad phases (MSC when built, DESS, NBS, AllPairs) and as
 plain YADE Polyhedra under InsertionSortCollider and SpatialQuickSortCollider.
 Prints a table, writes bench/out/compare_colliders.json and two plots beside it.
 
-Run with `yade -n -x examples/compare_colliders.py [--blocks 50] [--length 20] [--steps 100]`
+`--scene` picks one of the paper's scenes instead (examples/paper:
+hexahedra_drop, slanted_slide, single_block_slide), with the paper's
+material, time step and allowed step displacement.
+
+Run with `yade -n -x examples/compare_colliders.py [--blocks 50] [--length 20] [--steps 100]`,
+`yade -n -x examples/compare_colliders.py --scene hexahedra_drop --steps 300`,
 or `/usr/bin/python3 examples/compare_colliders.py ...`. SI units throughout.
 """
 import argparse
@@ -17,6 +22,11 @@ import os
 import sys
 
 from yade_dda import compareColliders
+
+# Under `yade -x` __file__ is YADE's launcher: find examples/paper from argv[0].
+_here = os.path.dirname(os.path.abspath(sys.argv[0] if sys.argv and sys.argv[0].endswith('.py') else __file__))
+sys.path.insert(0, os.path.join(_here, 'paper'))
+import paper_scenes  # noqa: E402
 
 
 def log(centre, length, angle):
@@ -51,6 +61,8 @@ def slenderPile(blocks=50, length=20.0, perLayer=7, spacing=1.5, gap=0.02, turn=
 
 def main(argv):
     parser = argparse.ArgumentParser(description=__doc__.split('\n')[0])
+    parser.add_argument('--scene', default='slender', choices=['slender'] + sorted(paper_scenes.SCENES),
+                        help="'slender' (the log pile below) or one of the paper's scenes")
     parser.add_argument('--blocks', type=int, default=50, help='blocks including the fixed bottom layer')
     parser.add_argument('--length', type=float, default=20.0, help='log length [m] (slenderness)')
     parser.add_argument('--steps', type=int, default=100)
@@ -61,6 +73,15 @@ def main(argv):
     parser.add_argument('--out', default=os.path.join('bench', 'out', 'compare_colliders.json'),
                         help='JSON path (plots beside it), relative to the current directory')
     args, _ = parser.parse_known_args(argv)
+    if args.scene != 'slender':
+        blocks, mat = paper_scenes.SCENES[args.scene]()
+        out = args.out if args.out != parser.get_default('out') else \
+            os.path.join('bench', 'out', 'compare_colliders_%s.json' % args.scene)
+        return compareColliders(blocks, steps=args.steps, dt=paper_scenes.STEP['dt'], gravity=(0, 0, -paper_scenes.G),
+                                young=mat['young'], poisson=mat['poisson'], density=mat['density'],
+                                frictionAngle=mat['frictionAngle'],
+                                integrator=dict(maxDisplacement=paper_scenes.STEP['maxDisplacement']),
+                                out=os.path.normpath(out))
     return compareColliders(lambda: slenderPile(args.blocks, args.length), steps=args.steps, dt=args.dt,
                             gravity=(0, 0, -9.81), young=args.young, poisson=0.25, density=2600,
                             frictionAngle=math.radians(30), integrator=dict(maxDisplacement=0.01),

@@ -31,11 +31,10 @@ from yade_dda import *          # noqa: E402,F401,F403
 import paper_scenes as scenes     # noqa: E402
 import paperscript              # noqa: E402
 
-p = paperscript.readParams(length=20.0, steps=600)
+p = paperscript.readParams(length=20.0, steps=600, collider='MSC')
 
 O.reset()
 blocks, mat = scenes.hexahedra_drop(length=p['length'])
 ids = paperscript.build(blocks, mat)
-O.engines = [DDAIntegrator(dt=scenes.STEP['dt'], gravity=(0, 0, -scenes.G),
-                           maxDisplacement=scenes.STEP['maxDisplacement'], label='dda')]
+O.engines = paperscript.engines(p['collider'])
 paperscript.run('hexahedra_drop (L = %g m)' % p['length'], ids, blocks, p['steps'])

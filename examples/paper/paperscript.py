@@ -15,7 +15,10 @@ import time
 
 import yade
 from yade import utils, wrapper
-from yade_dda import O, ddaBlock, block, stats, printStats, contacts
+import yade_dda
+from yade_dda import O, ddaBlock, block, stats, printStats, contacts, DDAIntegrator
+
+import paper_scenes as scenes
 
 PENETRATION_TOLERANCE = 1e-6   # largest initial penetration accepted [m]
 SAMPLE_PERIOD = 10             # steps between samples of stats() (peak penetration, contacts, dt)
@@ -63,6 +66,20 @@ def batchMode():
                 or not getattr(yade.runtime, 'hasDisplay', False))
 
 
+COLLIDERS = ('MSC', 'DESS', 'NBS', 'AllPairs')
+
+
+def engines(collider='MSC'):
+    """The paper's engines: the broad phase named `collider` (an engine of
+    COLLIDERS, default MSC, the paper's method) and the DDA integrator with
+    the paper's step controls (max dt, allowed step displacement), gravity g."""
+    if collider not in COLLIDERS:
+        raise SystemExit('unknown collider %r (one of %s)' % (collider, ', '.join(COLLIDERS)))
+    return [getattr(yade_dda, collider + 'Collider')(label='collider'),
+            DDAIntegrator(dt=scenes.STEP['dt'], gravity=(0, 0, -scenes.G),
+                          maxDisplacement=scenes.STEP['maxDisplacement'], label='dda')]
+
+
 def build(blocks, mat):
     """Appends the blocks [(vertices, fixed)] with material dict ``mat``; returns the body ids."""
     rock = O.materials.append(wrapper.PolyhedraMat(young=mat['young'], poisson=mat['poisson'],
@@ -84,6 +101,7 @@ class Run:
         self.peakContacts = 0
         self.smallestDt = float('inf')
         self.wall = 0.0
+        self.detection = dict(samples=0, candidatePairs=0, subUnitTests=0, seconds=0.0)
 
     def firstStep(self):
         """One step, then the initial checks: no NaN, no block starting inside another."""
@@ -110,6 +128,11 @@ class Run:
             self.peakPenetrationStep = O.iter + 1 if step is None else step
         self.peakContacts = max(self.peakContacts, s['contacts'])
         self.smallestDt = min(self.smallestDt, s['dt'])
+        d = self.detection
+        d['samples'] += 1
+        d['candidatePairs'] += s['candidatePairs']
+        d['subUnitTests'] += s['subUnitTests']
+        d['seconds'] += s['time']['broadPhase'] + s['time']['narrowPhase']
 
     def runBatch(self):
         """Blocking run of the remaining steps (batch mode)."""
@@ -170,6 +193,10 @@ class Run:
         print('  displacement-limit misses %d, open-close failures %d (cumulative)'
               % (s['displacementLimitMisses'], s['openCloseFailures']))
         print('  wall time          %.2f s, %.2f ms/step' % (self.wall, 1e3 * self.wall / max(steps, 1)))
+        n = max(self.detection['samples'], 1)
+        print('  detection (%s)   %.1f candidate pairs, %.0f sub-unit tests, %.3f ms per step (mean of %d samples)'
+              % (s['collider'], self.detection['candidatePairs'] / n,
+                 self.detection['subUnitTests'] / n, 1e3 * self.detection['seconds'] / n, self.detection['samples']))
         printStats()
         if self.peakPenetration > s['allowedDisplacement']:
             print('WARNING: a contact penetrated %.3e m, more than the allowed step displacement %.3e m '

@@ -29,11 +29,10 @@ from yade_dda import *          # noqa: E402,F401,F403
 import paper_scenes as scenes     # noqa: E402
 import paperscript              # noqa: E402
 
-p = paperscript.readParams(steps=20000)
+p = paperscript.readParams(steps=20000, collider='MSC')
 
 O.reset()
 blocks, mat = scenes.single_block_slide()
 ids = paperscript.build(blocks, mat)
-O.engines = [DDAIntegrator(dt=scenes.STEP['dt'], gravity=(0, 0, -scenes.G),
-                           maxDisplacement=scenes.STEP['maxDisplacement'], label='dda')]
+O.engines = paperscript.engines(p['collider'])
 paperscript.run('single_block_slide', ids, blocks, p['steps'])

@@ -135,10 +135,14 @@ def stats():
     for either reason below), ``displacementLimitMisses`` (cumulative steps
     accepted above the bound), ``maxDisplacement`` and ``allowedDisplacement``
     [m], ``blocks``, ``movingBlocks``, ``unknowns`` (system size).
-    Contacts: ``contactDistance`` [m] (d0 used), ``candidatePairs`` (block pairs
+    Contacts: ``collider`` (the broad phase used: 'MSC', 'DESS', 'NBS' or
+    'AllPairs'), ``contactDistance`` [m] (d0 used), ``candidatePairs`` (block pairs
     from the broad phase), ``shells``, ``shellPairs`` (overlapping bounding
     volumes), ``shellTests`` (volume comparisons), ``shellUpdates``,
-    ``subUnitPairs`` (vertex-face plus edge-edge pairs the candidates offer), ``contactPairs`` (pairs within d0), ``contacts``
+    ``subUnitPairs`` (vertex-face plus edge-edge pairs the candidates offer),
+    ``subUnitTests`` (vertex-face plane tests and edge-edge tests the narrow
+    phase made), ``fullSearchPairs`` (MSC pairs searched again with every
+    sub-unit because they penetrate deeper than d0/2), ``contactPairs`` (pairs within d0), ``contacts``
     (vertex-face and edge-edge sub-contacts), ``closedContacts``,
     ``slidingContacts``, ``openCloseIterations`` (solves in the accepted
     attempt), ``openCloseIterationsTotal`` (in all attempts),
@@ -161,6 +165,7 @@ def stats():
     result['stepTimeTotal'] = scene.stepTimeTotal
     result['pendingBodies'] = sum(1 for body, _ in scene.pending if body.id >= 0)
     result['steps'] = scene.core.steps()
+    result['collider'] = scene.core.collider()
     return result
 
 
