@@ -231,38 +231,75 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 	if (n < 2) return;
 
 	widened_.resize(shellTotal);
-	Eigen::AlignedBox3d centres;
+	Eigen::AlignedBox3d domain;
+	double sideSum = 0;
 	const double margin = kBroadPhaseMarginFactor * contactDistance;
 	for (int s = 0; s < shellTotal; ++s) {
 		const Vector3 w = Vector3::Constant(margin + covers_[shellBlock_[s]].widening);
 		widened_[s] = Eigen::AlignedBox3d(boxes_[s].min() - w, boxes_[s].max() + w);
-		centres.extend(widened_[s].center());
+		domain.extend(widened_[s]);
+		sideSum += widened_[s].sizes().maxCoeff();
 	}
-	int axis;
-	centres.sizes().maxCoeff(&axis);
-	order_.resize(shellTotal);
-	for (int s = 0; s < shellTotal; ++s) order_[s] = s;
-	std::sort(order_.begin(), order_.end(), [&](int s, int t) {
-		const double ms = widened_[s].min()(axis), mt = widened_[t].min()(axis);
-		return ms < mt || (ms == mt && s < t);
-	});
+
+	// Subspaces: cubic cells as wide as the mean shell's largest side (at
+	// least 1/kMaxCellsPerAxis of the domain). A shell enters every cell it
+	// overlaps; one spanning more than kMaxCellsPerShell cells (a floor, a
+	// block much larger than the rest) is compared with every shell instead.
+	// Two shells are compared in one cell only: the cell holding the lower
+	// corner of their boxes' intersection.
+	const Vector3 origin = domain.min();
+	const double cell = std::max(sideSum / shellTotal, domain.sizes().maxCoeff() / kMaxCellsPerAxis);
+	const auto cellOf = [&](const Vector3& x) {
+		return ((x - origin) / cell).array().floor().cast<long>().min(kMaxCellsPerAxis - 1).max(0).eval();
+	};
+	const auto key = [](const Eigen::Array<long, 3, 1>& c) {
+		return static_cast<std::uint64_t>(c.x()) << 42 | static_cast<std::uint64_t>(c.y()) << 21 |
+		       static_cast<std::uint64_t>(c.z());
+	};
+	cellEntries_.clear();
+	oversize_.clear();
+	for (int s = 0; s < shellTotal; ++s) {
+		const Eigen::Array<long, 3, 1> lo = cellOf(widened_[s].min()), hi = cellOf(widened_[s].max());
+		const Eigen::Array<long, 3, 1> span = hi - lo + 1;
+		if (span.prod() > kMaxCellsPerShell) {
+			oversize_.push_back(s);
+			continue;
+		}
+		for (long i = lo.x(); i <= hi.x(); ++i)
+			for (long j = lo.y(); j <= hi.y(); ++j)
+				for (long k = lo.z(); k <= hi.z(); ++k)
+					cellEntries_.emplace_back(key(Eigen::Array<long, 3, 1>(i, j, k)), s);
+	}
+	std::sort(cellEntries_.begin(), cellEntries_.end());
+	isOversize_.assign(shellTotal, 0);
+	for (int s : oversize_) isOversize_[s] = 1;
 
 	hits_.clear();
-	for (int p = 0; p < shellTotal; ++p) {
-		const int s = order_[p];
-		const int a = shellBlock_[s];
-		const Eigen::AlignedBox3d& boxS = widened_[s];
-		for (int q = p + 1; q < shellTotal; ++q) {
-			const int t = order_[q];
-			if (widened_[t].min()(axis) > boxS.max()(axis)) break;
-			const int b = shellBlock_[t];
-			if (a == b || (blocks[a].fixed && blocks[b].fixed)) continue;
-			++stats.shellTests;
-			if (!boxS.intersects(widened_[t])) continue;
-			const std::uint64_t bitS = std::uint64_t{1} << shellIndex_[s], bitT = std::uint64_t{1} << shellIndex_[t];
-			hits_.push_back(a < b ? ShellHit{a, b, bitS, bitT} : ShellHit{b, a, bitT, bitS});
-		}
+	const auto compare = [&](int s, int t) {
+		const int a = shellBlock_[s], b = shellBlock_[t];
+		if (a == b || (blocks[a].fixed && blocks[b].fixed)) return;
+		++stats.shellTests;
+		if (!widened_[s].intersects(widened_[t])) return;
+		const std::uint64_t bitS = std::uint64_t{1} << shellIndex_[s], bitT = std::uint64_t{1} << shellIndex_[t];
+		hits_.push_back(a < b ? ShellHit{a, b, bitS, bitT} : ShellHit{b, a, bitT, bitS});
+	};
+	const std::size_t entries = cellEntries_.size();
+	for (std::size_t first = 0; first < entries;) {
+		std::size_t last = first + 1;
+		while (last < entries && cellEntries_[last].first == cellEntries_[first].first) ++last;
+		const std::uint64_t here = cellEntries_[first].first;
+		for (std::size_t p = first; p < last; ++p)
+			for (std::size_t q = p + 1; q < last; ++q) {
+				const int s = cellEntries_[p].second, t = cellEntries_[q].second;
+				const Vector3 low = widened_[s].min().cwiseMax(widened_[t].min());
+				if (key(cellOf(low)) != here) continue;  // compared in another cell
+				compare(s, t);
+			}
+		first = last;
 	}
+	for (int s : oversize_)
+		for (int t = 0; t < shellTotal; ++t)
+			if (t != s && (!isOversize_[t] || s < t)) compare(s, t);
 	stats.shellPairs = static_cast<long>(hits_.size());
 	std::sort(hits_.begin(), hits_.end());
 

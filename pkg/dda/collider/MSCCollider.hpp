@@ -8,8 +8,9 @@
 // and per vertex, edge and face the shells whose closed slab it touches (its
 // linked shells). DDA moves blocks by affine maps, which keep fractions and
 // slab membership: the cover moves with the block, and each step only moving
-// blocks' boxes are recomputed. Shells widened by d0 are swept as in DESS; a
-// pair is a candidate when two of its shells overlap. Where the paper lets the
+// blocks' boxes are recomputed. Shells widened by d0 are entered in the
+// cells of a uniform grid (the paper's subspaces) and compared within cells;
+// a pair is a candidate when two of its shells overlap. Where the paper lets the
 // nearest shell decide, a pair here links the union of its overlapping shells'
 // sub-units, each once: every feature of its contacts while penetration stays
 // below d0 / 2 (argued in the .cpp). The narrow phase (detectPairContacts with
@@ -23,6 +24,7 @@
 
 #include <cstdint>
 #include <map>
+#include <utility>
 #include <vector>
 
 namespace dda {
@@ -43,6 +45,11 @@ public:
 	// past d0, and above the round-off of division points and of affine
 	// motion (~1e-16 relative per step); 4e-8 of a 10 m block is 0.4 um.
 	static constexpr double kShellWideningRelative = 4e-8;
+	// Subspaces: at most this many cells per axis (cell keys are 3 x 21 bits)
+	// and a shell spanning more cells than kMaxCellsPerShell is compared with
+	// every shell rather than entered in each.
+	static constexpr long kMaxCellsPerAxis = 1 << 20;
+	static constexpr long kMaxCellsPerShell = 64;
 
 	// criticalLengthFactor > 0 [-], segments in [1, kMaxSegments]; InputError otherwise.
 	explicit MSCCollider(double criticalLengthFactor = kDefaultCriticalLengthFactor,
@@ -120,7 +127,9 @@ private:
 	std::vector<Eigen::AlignedBox3d> boxes_;  // per flat shell, not widened
 	std::vector<int> shellBlock_, shellIndex_;  // per flat shell
 	std::vector<Eigen::AlignedBox3d> widened_;
-	std::vector<int> order_;
+	std::vector<std::pair<std::uint64_t, int>> cellEntries_;  // (cell key, shell), sorted
+	std::vector<int> oversize_;   // shells compared with every shell
+	std::vector<char> isOversize_;
 	std::vector<ShellHit> hits_;
 	std::vector<LinkedSubUnits> linked_;  // pool: the first linkedCount_ are valid
 	int linkedCount_ = 0;
