@@ -174,8 +174,6 @@ def referenceData(record, row, command):
         'script': record['script'],
         'params': record['params'],
         'values': values,
-        'tolerances': {c['name']: {'abs': c['abs'], 'rel': c['rel']} for c in record['checks']
-                       if c['kind'] == 'reference'},
         'generated': {'date': datetime.datetime.now().isoformat(timespec='seconds'),
                       'command': command, 'versions': record.get('versions'),
                       'run': record.get('run')},
@@ -298,7 +296,7 @@ def main(argv=None):
     if duplicates:
         parser.error('table %s: descriptions must be unique (they name records and references): %s'
                      % (args.table, ', '.join(duplicates)))
-    command = ' '.join(['check.py'] + (argv if argv is not None else sys.argv[1:]))
+    command = 'check.py %s RECORDS --update' % os.path.basename(args.table)
     results, records = [], {}
     for l in lines:
         records[rows[l]['description']] = checkRow(l, rows[l], args.records, args.references,

@@ -5,14 +5,20 @@ Ten identical cubes stacked with coincident corners on a fixed 5 x 5 x 1 m
 floor, hard rock (E = 10 GPa, nu = 0.25, rho = 2600 kg/m^3), friction angle
 `phiDeg`, released unloaded under gravity. There is no closed form for the
 start-up (the column rings as its weight comes onto the penalty springs) so
-the final centroids and rotations are compared with a stored reference
+the final state is compared with a stored reference
 (references/<description>.json), made by `check.py --update`:
 
-- centroids: abs 1e-6 m. The column's elastic shortening at rest is
-  sum (k - 1/2) rho g L^2 / E = 1.3e-4 m at the top; 1e-6 m is under 1% of
-  it and far above round-off (the run is deterministic: same result for
-  any thread count and, by construction, for every collider).
-- rotation vectors: abs 1e-7 rad.
+- heights of the centroids: abs 2e-6 m. The column's elastic shortening at
+  rest is sum (k - 1/2) rho g L^2 / E = 1.3e-4 m at the top; 2e-6 m is 1.5%
+  of it. The run is deterministic (any thread count; every collider gives
+  the same contacts, hence the same numbers), but not smooth in round-off:
+  moving the cubes by 1e-12 m at the start changes the heights by up to
+  4e-7 m, hence not tighter.
+- sideways positions (x, y) of the centroids and the rotation vectors: abs
+  2e-4 m and 2e-4 rad. The start-up leaves the cubes shifted by up to
+  6e-5 m and turned about z by up to 6e-5 rad, and those amounts are chaotic:
+  the same 1e-12 m at the start changes them by 5e-5. So they are kept only
+  as a bound, like the closed-form checks below.
 
 Closed-form checks beside the reference: the stack is symmetric, so no cube
 shifts sideways (< 1e-4 m) or tilts (< 1e-4 rad), and the top cube settles
@@ -47,8 +53,9 @@ regression.runTo(tEnd)
 centroids = [list(block(c).centroid) for c in cubes]
 rotations = [list(block(c).rotation.toRotationVector()) for c in cubes]
 rec = regression.Record()
-rec.reference('centroids', centroids, abs=1e-6, unit='m')
-rec.reference('rotations', rotations, abs=1e-7, unit='rad')
+rec.reference('heights', [p[2] for p in centroids], abs=2e-6, unit='m')
+rec.reference('sideways positions', [p[0:2] for p in centroids], abs=2e-4, unit='m')
+rec.reference('rotations', rotations, abs=2e-4, unit='rad')
 rec.closedForm('largest sideways shift', max(math.hypot(p[0] - s[0], p[1] - s[1]) for p, s in zip(centroids, starts)),
                0.0, abs=1e-4, unit='m', formula='0 (symmetric stack)')
 rec.closedForm('largest tilt', max(math.sqrt(sum(r * r for r in rot)) for rot in rotations), 0.0, abs=1e-4,
