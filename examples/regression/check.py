@@ -135,8 +135,6 @@ def compare(measured, expected, absTol, relTol):
         diff = abs(m - e)
         ok = math.isfinite(m) and math.isfinite(e) and diff <= allowed
         ratio = diff / allowed if allowed > 0 and math.isfinite(diff) else math.inf
-        if not ok:
-            ratio = max(ratio, 1.0 + 1e-300)
         passed = passed and ok
         if ratio > worstRatio or worst is None:
             worst, worstRatio = (i, m, e, diff, allowed), ratio
@@ -167,7 +165,7 @@ def logTail(logs, description, lines=6):
     return 'log %s ends:\n' % path + '\n'.join('      | ' + l for l in text[-lines:])
 
 
-def referenceData(record, row, command):
+def referenceData(record, command):
     values = {c['name']: c['measured'] for c in record['checks'] if c['kind'] == 'reference'}
     return {
         'description': record['description'],
@@ -180,7 +178,7 @@ def referenceData(record, row, command):
     }
 
 
-def checkRow(line, row, records, references, logs, update, command, out):
+def checkRow(row, records, references, logs, update, command, out):
     description = row['description']
     script = os.path.basename(row.get('!SCRIPT', '')) or None
     path = os.path.join(records, description + '.json')
@@ -213,7 +211,7 @@ def checkRow(line, row, records, references, logs, update, command, out):
     if refChecks and update:
         os.makedirs(references, exist_ok=True)
         with open(refPath, 'w') as f:
-            json.dump(referenceData(record, row, command), f, indent=1)
+            json.dump(referenceData(record, command), f, indent=1)
             f.write('\n')
         print('reference written: %s' % refPath)
     if refChecks:
@@ -251,7 +249,7 @@ def fmt(x):
     return '%.6g' % x
 
 
-def printTable(results, records, stream=sys.stdout):
+def printTable(results, stream=sys.stdout):
     header = ('scene', 'check', 'against', 'measured', 'expected', '|diff|', 'allowed', 'result')
     rows = []
     for r in results:
@@ -299,11 +297,11 @@ def main(argv=None):
     command = 'check.py %s RECORDS --update' % os.path.basename(args.table)
     results, records = [], {}
     for l in lines:
-        records[rows[l]['description']] = checkRow(l, rows[l], args.records, args.references,
+        records[rows[l]['description']] = checkRow(rows[l], args.records, args.references,
                                                    args.logs or args.records, args.update, command, results)
     print('regression check: table %s, %d scenes, records in %s, references in %s'
           % (args.table, len(lines), args.records, args.references))
-    printTable(results, records)
+    printTable(results)
     failedScenes = sorted(set(r.scene for r in results if not r.passed))
     wall = sum((rec or {}).get('run', {}).get('wallTime') or 0.0 for rec in records.values())
     print('%d checks in %d scenes: %d passed, %d failed; scenes failed: %s; scene wall time %.1f s'

@@ -38,6 +38,7 @@ import os
 import subprocess
 import sys
 import time
+import warnings
 
 from ._yade import O, utils
 
@@ -45,11 +46,6 @@ RECORDS_ENV = 'YADE_DDA_RECORDS'
 FORMAT = 1
 
 _state = {'declared': None, 'table': None, 'start': None}
-
-
-def _tableFileLine():
-    batch = os.environ.get('YADE_BATCH', '')
-    return batch or None
 
 
 def readParamsFromTable(tableFileLine=None, noTableOk=True, **defaults):
@@ -62,7 +58,7 @@ def readParamsFromTable(tableFileLine=None, noTableOk=True, **defaults):
     clock of the record. Returns the number of parameters the row set.
     """
     _state['start'] = time.time()
-    tableFileLine = tableFileLine or _tableFileLine()
+    tableFileLine = tableFileLine or os.environ.get('YADE_BATCH') or None   # yade-batch sets 'table:line'
     _state['declared'] = sorted(defaults)
     _state['table'] = tableFileLine
     if not tableFileLine:
@@ -82,9 +78,9 @@ def readParamsFromTable(tableFileLine=None, noTableOk=True, **defaults):
                             % (tableFile, line, column, value, column, ', '.join(sorted(defaults))))
         if value == '*':
             starred[column] = defaults.get(column)
-    # YADE 2023.02a evaluates the default of a '*' cell as if it were the cell's text (a TypeError
-    # for a number) and then stores that text as the value. So '*' cells get their default's repr
-    # to evaluate, and the true defaults are stored over them afterwards.
+    # YADE 2023.02a's readParamsFromTable passes the default of a '*' cell to eval() (a TypeError for
+    # a number, a NameError for a string such as 'DESS') and then stores the unevaluated default. So
+    # '*' cells get their default's repr, which evaluates, and the true defaults are stored afterwards.
     params = dict(defaults)
     for column, value in starred.items():
         text = repr(value)
@@ -98,7 +94,6 @@ def readParamsFromTable(tableFileLine=None, noTableOk=True, **defaults):
         params[column] = text
     count = utils.readParamsFromTable(tableFileLine=tableFileLine, noTableOk=noTableOk, **params)
     if starred:
-        import warnings
         with warnings.catch_warnings():
             warnings.simplefilter('ignore')      # "Overwriting yade.params.table which already exists"
             utils.saveVars('table', loadNow=True, **starred)
