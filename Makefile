@@ -8,7 +8,7 @@ DEB_PACKAGES := yade cmake g++ make libeigen3-dev libcgal-dev libgmp-dev libmpfr
                 libgtest-dev
 SITE_DIR := $(shell $(PYTHON) -c "import sysconfig;print(sysconfig.get_path('purelib','posix_local'))" 2>/dev/null)
 
-.PHONY: deps build install demo test test-cpp test-py bench clean
+.PHONY: deps build install demo test test-cpp test-py bench regress regress-quick regress-run clean
 
 deps:
 	@missing=$$(for p in $(DEB_PACKAGES); do dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null | grep -q 'install ok installed' || echo $$p; done); \
@@ -38,6 +38,28 @@ test: install
 bench: install
 	$(PYTHON) bench/free_blocks.py
 	$(PYTHON) bench/contacts.py
+
+# Batch regressions (README, "Batch regressions"): yade-batch runs every row of a table in
+# examples/regression, each scene writes a record, check.py compares them with closed forms and
+# stored references and exits non-zero on any failure. Logs and records go to $(REGRESS_OUT)/<table>.
+REGRESS_OUT := $(BUILD)/regress
+YADE_BATCH  := yade-batch
+
+regress: install
+	$(MAKE) --no-print-directory regress-run TABLE=full
+
+regress-quick: install
+	$(MAKE) --no-print-directory regress-run TABLE=quick
+
+# Runs TABLE (quick or full) with whatever yade_dda YADE imports (the installed one; set
+# PYTHONPATH=$(BUILD)/py for the build tree). CHECK_ARGS are passed to check.py (e.g. --update).
+TABLE ?= quick
+regress-run:
+	@out=$(abspath $(REGRESS_OUT))/$(TABLE); rm -rf $$out && mkdir -p $$out && \
+	echo "yade-batch $(TABLE).table: logs and records in $$out" && \
+	(cd examples/regression && YADE_DDA_RECORDS=$$out $(YADE_BATCH) -j $(JOBS) --disable-pynotify \
+	    --log "$$out/@.log" $(TABLE).table 2>&1) | tee $$out/yade-batch.log | grep --line-buffered -E '^#[0-9]+ \('; true
+	$(PYTHON) examples/regression/check.py examples/regression/$(TABLE).table $(abspath $(REGRESS_OUT))/$(TABLE) $(CHECK_ARGS)
 
 clean:
 	rm -rf $(BUILD)
