@@ -113,26 +113,25 @@ def fingerprint():
 
 
 class Guard:
-    """Checks a running scene after every step (call `check()` after O.step()).
+    """Checks a running scene after every step (call `check()` after O.step(), or `run(n)`).
 
-    bodies: the scene's DDA body ids (moving and fixed); extraPenetration [m]:
-    added to the penetration tolerance where a case says why; maxCutsPerStep / maxCutFraction: open-close dt cuts
-    allowed in one step / per accepted step over the run. `pairs` limits the
-    geometric overlap check to these body pairs (default: every pair with a
-    moving block).
+    bodies: the scene's DDA body ids (moving and fixed); gravity [m/s^2];
+    extraPenetration [m]: added to the penetration tolerance where a case
+    says why; maxCutsPerStep / maxCutFraction: open-close dt cuts allowed in
+    one step (5: dt never below 0.3^5 = 1/400 of the step tried) and over
+    the run per step taken (5%); `pairs` limits the geometric overlap check
+    to these body pairs (default: every pair with a moving block).
     """
 
-    def __init__(self, bodies, gravity, extraPenetration=0.0, maxCutsPerStep=5, maxCutFraction=0.05,
-                 pairs=None, geometryEvery=1):
+    def __init__(self, bodies, gravity, extraPenetration=0.0, maxCutsPerStep=5, maxCutFraction=0.05, pairs=None):
         self.bodies = list(bodies)
         self.g = numpy.asarray(gravity, float)
         self.extraPenetration = extraPenetration
         self.maxCutsPerStep = maxCutsPerStep
         self.maxCutFraction = maxCutFraction
-        self.geometryEvery = geometryEvery
+        self.views = {b: yade_dda.block(b) for b in self.bodies}
         self.info = {}
-        for b in self.bodies:
-            blk = yade_dda.block(b)
+        for b, blk in self.views.items():
             mat = O.bodies[b].material
             self.info[b] = dict(fixed=blk.fixed, young=mat.young, size=blk.volume ** (1.0 / 3.0),
                                 compliance=compliance(mat.young, mat.poisson),
@@ -142,13 +141,12 @@ class Guard:
             pairs = [(a, b) for i, a in enumerate(self.bodies) for b in self.bodies[i + 1:]
                      if not (self.info[a]['fixed'] and self.info[b]['fixed'])]
         self.pairs = list(pairs)
-        self.fixedVertices = {b: self.corners(b) for b in self.bodies if self.info[b]['fixed']}
+        self.fixedCorners = {b: self.corners(b) for b in self.bodies if self.info[b]['fixed']}
         self.integrator = O.engines[-1]
-        self.mass = sum(yade_dda.block(b).mass for b in self.moving)
+        self.mass = sum(self.views[b].mass for b in self.moving)
         self.size = max(self.info[b]['size'] for b in self.bodies)
         self.kn = self.integrator.contactPenaltyFactor * min(self.info[b]['young'] * self.info[b]['size']
                                                              for b in self.bodies)
-        self.kineticMax = 0.0
         self.steps = 0
         self.cuts = 0
         self.worstPenetration = 0.0        # stats()['maxPenetration'], over the run [m]
@@ -156,18 +154,20 @@ class Guard:
         self.worstGain = -math.inf         # energy minus initial energy, over the run [J]
         self.e0, parts = self.energy(parts=True)
         self.kineticMax = parts['kinetic']
-        self.energies = [self.e0]
-        self.history = []
+
+    def corners(self, b):
+        return numpy.array([tuple(v) for v in self.views[b].vertices])
 
     def energy(self, parts=False):
         """Total mechanical energy [J] (see the module docstring); `parts` gives the terms."""
         kinetic = gravity = strain = springs = 0.0
         for b in self.moving:
-            blk = yade_dda.block(b)
-            kinetic += S.kinetic_energy(blk.mass, blk.volume, blk.secondMoment, blk.velocity)
-            gravity -= blk.mass * float(self.g @ numpy.asarray(tuple(blk.centroid)))
+            blk = self.views[b]
+            mass, volume = blk.mass, blk.volume
+            kinetic += S.kinetic_energy(mass, volume, blk.secondMoment, blk.velocity)
+            gravity -= mass * float(self.g @ numpy.asarray(tuple(blk.centroid)))
             sigma = numpy.asarray(tuple(blk.stress))
-            strain += 0.5 * blk.volume * float(sigma @ self.info[b]['compliance'] @ sigma)
+            strain += 0.5 * volume * float(sigma @ self.info[b]['compliance'] @ sigma)
         for c in yade_dda.contacts():
             if c.state == 'open':
                 continue
@@ -200,15 +200,15 @@ class Guard:
         stake, W L (the weight over one block size) plus K (as in `penetration`)."""
         return 1e-9 * (self.mass * float(numpy.linalg.norm(self.g)) * self.size + self.kineticMax)
 
-    def corners(self, b):
-        return numpy.array([tuple(v) for v in yade_dda.block(b).vertices])
-
-    def overlap(self):
+    def overlap(self, corners=None):
         """Largest geometric overlap depth [m] over the guarded pairs, and the pair."""
+        if corners is None:
+            corners = {b: self.corners(b) for b in self.moving}
         worst, which = -math.inf, None
-        corners = {b: self.fixedVertices[b] if b in self.fixedVertices else self.corners(b) for b in self.bodies}
         for a, b in self.pairs:
-            d = overlap_depth(corners[a], self.info[a]['topology'], corners[b], self.info[b]['topology'])
+            A = self.fixedCorners[a] if a in self.fixedCorners else corners[a]
+            B = self.fixedCorners[b] if b in self.fixedCorners else corners[b]
+            d = overlap_depth(A, self.info[a]['topology'], B, self.info[b]['topology'])
             if d > worst:
                 worst, which = d, (a, b)
         return worst, which
@@ -218,10 +218,13 @@ class Guard:
         self.steps += 1
         s = yade_dda.stats()
         where = 'step %d (t = %.6g s, dt = %.3g s)' % (O.iter, O.time, s['dt'])
+        corners = {}
         for b in self.moving:
-            blk = yade_dda.block(b)
-            values = [x for v in blk.vertices for x in v] + list(blk.velocity) + list(blk.stress) + list(blk.strain)
-            assert all(math.isfinite(x) for x in values), 'non-finite state of body %d at %s' % (b, where)
+            blk = self.views[b]
+            corners[b] = self.corners(b)
+            finite = numpy.isfinite(corners[b]).all() and all(
+                math.isfinite(x) for x in tuple(blk.velocity) + tuple(blk.stress) + tuple(blk.strain))
+            assert finite, 'non-finite state of body %d at %s' % (b, where)
         assert s['openCloseFailures'] == 0, 'open-close iteration accepted unconverged at %s' % where
         assert s['openCloseCuts'] <= self.maxCutsPerStep, \
             '%d open-close dt cuts in one step at %s (bound %d)' % (s['openCloseCuts'], where, self.maxCutsPerStep)
@@ -236,12 +239,10 @@ class Guard:
         self.worstPenetration = max(self.worstPenetration, s['maxPenetration'])
         assert s['maxPenetration'] <= tolerance, \
             'contact penetration %.3e m at %s (tolerance %.3e m)' % (s['maxPenetration'], where, tolerance)
-        if self.steps % self.geometryEvery == 0:
-            depth, pair = self.overlap()
-            self.worstOverlap = max(self.worstOverlap, depth)
-            assert depth <= tolerance, \
-                'bodies %s overlap by %.3e m at %s (tolerance %.3e m)' % (pair, depth, where, tolerance)
-        self.energies.append(e)
+        depth, pair = self.overlap(corners)
+        self.worstOverlap = max(self.worstOverlap, depth)
+        assert depth <= tolerance, \
+            'bodies %s overlap by %.3e m at %s (tolerance %.3e m)' % (pair, depth, where, tolerance)
         self.worstGain = max(self.worstGain, e - self.e0)
         assert e - self.e0 <= self.energySlack(), \
             'energy gain %.3e J at %s (initial %.6e J, slack %.3e J)' % (e - self.e0, where, self.e0,

@@ -93,7 +93,7 @@ def bodies():
     return list(ddaScene.bodyOfBlock)
 
 
-def run_case(build, steps, guardOptions=None, every=None, **integratorOptions):
+def run_case(build, steps, guardOptions=None, every=None, gravity=GRAVITY, **integratorOptions):
     """Runs a hard case under every guard; returns (guard, what `build` returned).
 
     `every(built)`, if given, is called after each guarded step (to record
@@ -109,12 +109,12 @@ def run_case(build, steps, guardOptions=None, every=None, **integratorOptions):
     for threads in (2, 1):
         O.reset()
         built = build()
-        O.engines = [integrator(threads=threads, **integratorOptions)]
+        O.engines = [integrator(threads=threads, gravity=gravity, **integratorOptions)]
         if threads == 2:
             for _ in range(steps):
                 O.step()
         else:
-            guard = Guard(bodies(), GRAVITY, **(guardOptions or {}))
+            guard = Guard(bodies(), gravity, **(guardOptions or {}))
             guard.run(steps, None if every is None else lambda step: every(built))
         fingerprints.append(fingerprint())
     assert fingerprints[0] == fingerprints[1], 'the run with 2 threads differs from the run with 1'
@@ -167,7 +167,22 @@ def test_overlap_depth_matches_closed_forms():
 
 # ================================================================ degenerate geometry
 
-CORNER_DROPS = ['aligned', 'apex', 'apex-turned']
+# Cases that fail on a core fault (diagnosed in the docstring of each reason; the
+# fixes are outside what this suite may change). Strict: once the core is
+# fixed they pass, the xfail fails, and the marker must go.
+NARROW_PHASE_LINE_CONTACT = pytest.mark.xfail(strict=True, reason=(
+    'core fault, narrow phase (PairDetection): an edge entrance gives one edge-edge sub-contact only, also '
+    'when the edge lies almost in a face of the other block (a line contact, here the lower cube\'s edge '
+    'along the upper cube\'s face, 1e-3 rad apart); the edge\'s end corner (the apex) is no contact and '
+    'sinks 1.76e-4 m into that face at step 345 (tolerance 1.42e-4 m), then is thrown out (3300 J lost)'))
+FRICTION_SWITCH_CAP = pytest.mark.xfail(strict=True, reason=(
+    'core fault, open-close iteration (World::step): after kFrictionSwitchesCounted switches a contact\'s '
+    'sliding/locked switch still changes its state but no longer counts as a change, so the step is '
+    'accepted with a solve made for the state it just left: a sliding contact whose motion reversed ends '
+    'locked with a shear spring stretched by the whole step\'s slip (|S| = 6.5e7 N vs tan(phi) N = 1.1e4 N) '
+    'and the friction load of that solve pushed along the motion: energy gain'))
+
+CORNER_DROPS = ['aligned', 'apex', pytest.param('apex-turned', marks=NARROW_PHASE_LINE_CONTACT)]
 
 
 @pytest.mark.parametrize('placement', CORNER_DROPS)
@@ -200,7 +215,8 @@ def test_corner_dropped_exactly_on_corner(scene, placement):
 
 
 EDGE_CROSSINGS = {'90deg': math.pi / 2, '30deg': math.radians(30)}
-NEAR_PARALLEL = [1e-2, 1e-4, 1e-6, 1e-8, 0.0]
+NEAR_PARALLEL = [pytest.param(t, id='%g' % t, marks=FRICTION_SWITCH_CAP if t == 1e-8 else ())
+                 for t in (1e-2, 1e-4, 1e-6, 1e-8, 0.0)]
 
 
 def edge_on_edge(theta, gap=0.02):
@@ -235,7 +251,7 @@ def test_crossing_edges_meet_edge_on_edge(scene, angle):
     assert lowest > -guard.penetration()
 
 
-@pytest.mark.parametrize('theta', NEAR_PARALLEL, ids=['%g' % t for t in NEAR_PARALLEL])
+@pytest.mark.parametrize('theta', NEAR_PARALLEL)
 def test_near_parallel_edges(scene, theta):
     """The same two bars with their edges theta from parallel, theta = 1e-2 down to 1e-8 rad and 0.
 
@@ -250,7 +266,7 @@ def test_near_parallel_edges(scene, theta):
     assert guard.worstPenetration > 0
 
 
-STACKS = ['aligned', 'offset', 'turned45', 'turned1e-9']
+STACKS = ['aligned', pytest.param('offset', marks=FRICTION_SWITCH_CAP), 'turned45', 'turned1e-9']
 
 
 @pytest.mark.parametrize('kind', STACKS)
@@ -555,3 +571,101 @@ def test_wedge_at_factor_of_safety_one(scene, fs):
     else:
         assert S.norm(d) < 1e-4
         assert S.norm(S.sub(centroid(wedge), atHalfSecond[0])) < 1e-9
+
+
+# ================================================================ long run, threads
+
+STACK_TILTS = [0.0, pytest.param(10.0, marks=FRICTION_SWITCH_CAP)]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize('tiltDeg', STACK_TILTS, ids=['level', 'tilted10deg'])
+def test_resting_stack_for_20000_steps(scene, tiltDeg):
+    """A tower of four 1 m cubes with exactly coincident corners on a fixed floor (friction 30 deg),
+    20,000 steps of 1 ms; level, and with gravity tilted by 10 deg (the tower on a 10 deg slope: its
+    joints carry shear, tan 10 deg = 0.18 of their normal force against 0.58 available, and the
+    tower's weight passes 0.15 m inside its downhill edge).
+
+    What could go wrong over a long run: round-off in the contact
+    linearisation or the stress update accumulates (the tower creeps,
+    tilts or sinks); shear springs that lose their stretch when they
+    re-lock ratchet the tilted tower downhill; energy leaks in one step in
+    10,000 and the tower ends up moving; the iteration starts cycling once
+    the contacts' forces are settled to round-off. The tower must stand: no
+    cube moves more than 1e-4 m (elastic settling and shear ~1e-5 m) or
+    turns more than 1e-4 rad; over the second half the centroids move less
+    than 1e-8 m (no creep), and the kinetic energy at the end is below 1e-9
+    of m g L.
+    """
+    steps = 20000
+    tilt = math.radians(tiltDeg)
+    gravity = (G * math.sin(tilt), 0.0, -G * math.cos(tilt))
+
+    def build():
+        floor(0.0, frictionDeg=30)
+        return [(S.add_block(S.box((0, 0, k), (1, 1, k + 1)), rock(30)), (0.5, 0.5, k + 0.5)) for k in range(4)]
+
+    halfway = []
+
+    def record(cubes):
+        if O.iter == steps // 2:
+            halfway.extend(centroid(cube) for cube, _ in cubes)
+
+    guard, cubes = run_case(build, steps, every=record, gravity=gravity)
+    for (cube, c0), cHalf in zip(cubes, halfway):
+        assert S.norm(S.sub(centroid(cube), c0)) < 1e-4, cube
+        assert yade_dda.block(cube).rotation.toRotationVector().norm() < 1e-4
+        assert S.norm(S.sub(centroid(cube), cHalf)) < 1e-8
+    kinetic = guard.energy(parts=True)[1]['kinetic']
+    assert kinetic < 1e-9 * guard.mass * G * 1.0
+
+
+@pytest.mark.slow
+def test_threads_do_not_change_a_hard_field(scene):
+    """Determinism with threads engaged: 1100 hard placements side by side on one floor, 1375 moving
+    blocks in 1100 independent systems (above the core's threading threshold of 1024 blocks, pairs and
+    components), 20 steps with 2 threads and with 1, bitwise the same, every guard on (1 thread).
+
+    In each 2 m cell, by turn: a stack of two cubes face on face (gap 0), a
+    cube on its corner exactly on the floor, a cube on an edge exactly on
+    the floor, a cube face down spinning at 3 rad/s. What could go wrong:
+    a reduction whose order depends on the thread count, a contact list
+    filled in thread order, a shared scratch buffer.
+    """
+    def build():
+        floor(0.0, size=(-1.0, -1.0, 67.0, 67.0), frictionDeg=30)
+        stacks = []
+        for k in range(1100):
+            x, y = 2.0 * (k % 33) + 0.5, 2.0 * (k // 33) + 0.5
+            kind = k % 4
+            if kind == 0:
+                a = S.add_block(S.box((x - 0.4, y - 0.4, 0), (x + 0.4, y + 0.4, 0.8)), rock(30))
+                b = S.add_block(S.box((x - 0.4, y - 0.4, 0.8), (x + 0.4, y + 0.4, 1.6)), rock(30))
+                stacks.append((a, b))
+            elif kind == 1:
+                S.add_block(corner_down_cube((x, y, 0.0), side=0.8, turn=0.1 * (k % 7)), rock(30))
+            elif kind == 2:
+                pts = rotate(S.box((-0.4, -0.4, -0.4), (0.4, 0.4, 0.4)), (1, 0, 0), math.pi / 4)
+                S.add_block(shifted(pts, (x, y, 0.4 * math.sqrt(2))), rock(30))
+            else:
+                c = S.add_block(S.box((x - 0.4, y - 0.4, 0), (x + 0.4, y + 0.4, 0.8)), rock(30))
+                O.bodies[c].state.angVel = (0, 0, 3.0)
+        return stacks
+
+    fingerprints = []
+    for threads in (2, 1):
+        O.reset()
+        stacks = build()
+        O.engines = [integrator(threads=threads)]
+        if threads == 2:
+            for _ in range(20):
+                O.step()
+        else:
+            ids = bodies()
+            guard = Guard(ids, GRAVITY, pairs=[(ids[0], b) for b in ids[1:]] + stacks)
+            assert len(guard.moving) >= 1024
+            guard.run(20)
+        s = yade_dda.stats()
+        assert s['contactPairs'] >= 1024 and s['components'] >= 1024 and s['movingBlocks'] >= 1024
+        fingerprints.append(fingerprint())
+    assert fingerprints[0] == fingerprints[1]
