@@ -31,7 +31,6 @@ from helpers import rotate
 from hardguards import Guard, fingerprint
 
 GRAVITY = (0.0, 0.0, -G)
-PENALTY = 40.0            # DDAIntegrator's default contactPenaltyFactor
 deg = math.radians
 
 
@@ -327,7 +326,7 @@ def test_slender_block_sliding(scene, motion):
     and 1e-6 rad/s: nothing resists); on the incline it must follow
     g (sin a - tan(phi) cos a) t^2 / 2 within 1%; it must stay flat (turned
     by less than 1e-4 rad; friction at the base pitches a block on an
-    incline by the spring compliance only, ~1e-6 rad).
+    incline by the spring compliance only, 5e-8 rad here).
     """
     def build():
         if motion == 'incline':
@@ -452,7 +451,7 @@ def test_vertex_slides_across_boundary_between_faces(scene, ridge):
     (energy gain). Every corner must end past the ridge and the block must
     keep moving forward at >= 60% of its start speed (a block landing on
     the far slope after tipping over the ridge loses some energy in that
-    impact: 3% to 13% here).
+    impact: 2.5% to 16% of its kinetic energy here).
     """
     slopeDeg, azimuth = RIDGES[ridge]
     speed = 2.0
