@@ -8,7 +8,7 @@ DEB_PACKAGES := yade cmake g++ make libeigen3-dev libcgal-dev libgmp-dev libmpfr
                 libgtest-dev
 SITE_DIR := $(shell $(PYTHON) -c "import sysconfig;print(sysconfig.get_path('purelib','posix_local'))" 2>/dev/null)
 
-.PHONY: deps build install demo test test-cpp test-py bench regress regress-quick regress-run clean
+.PHONY: deps build install demo test test-hard test-cpp test-py bench regress regress-quick regress-run clean
 
 deps:
 	@missing=$$(for p in $(DEB_PACKAGES); do dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null | grep -q 'install ok installed' || echo $$p; done); \
@@ -34,6 +34,11 @@ demo: install
 test: install
 	cd $(BUILD) && ctest --output-on-failure
 	$(PYTHON) -m pytest -q tests/py
+
+# Everything `test` runs plus the cases marked slow (pytest.ini deselects them by default).
+test-hard: install
+	cd $(BUILD) && ctest --output-on-failure
+	$(PYTHON) -m pytest -q -m "slow or not slow" tests/py
 
 bench: install
 	$(PYTHON) bench/free_blocks.py
