@@ -36,6 +36,7 @@ test: install
 bench: install
 	$(PYTHON) bench/free_blocks.py
 	$(PYTHON) bench/contacts.py
+	$(PYTHON) bench/colliders.py
 
 clean:
 	rm -rf $(BUILD)
