@@ -43,6 +43,7 @@ test-hard: install
 bench: install
 	$(PYTHON) bench/free_blocks.py
 	$(PYTHON) bench/contacts.py
+	$(PYTHON) bench/colliders.py
 
 # Batch regressions (README, "Batch regressions"): yade-batch runs every row of a table in
 # examples/regression, each scene writes a record, check.py compares them with closed forms and
