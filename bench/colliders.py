@@ -716,7 +716,7 @@ def main():
             os.remove(taskFile)
             record['processSeconds'] = time.time() - t0
             warnings = [line for line in proc.stderr.splitlines() if 'WARN' in line or 'ERROR' in line]
-            if warnings:        # e.g. YADE's polyhedra intersection: "Unhandled switch case" (pairs it skips)
+            if warnings:        # e.g. YADE's per-pair do_intersect notice (with --yade-warnings)
                 record['stderrWarnings'] = dict(count=len(warnings), distinct=sorted(set(warnings))[:5])
             result['records'].append(record)
             summary = summarise(record)
