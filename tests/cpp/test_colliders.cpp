@@ -3,6 +3,7 @@
 // whose narrow phase finds a contact, so all of them end with exactly the
 // contact set of AllPairsCollider.
 #include "dda/collider/Collider.hpp"
+#include "dda/collider/MSCCollider.hpp"
 #include "dda/contact/PairDetection.hpp"
 #include "dda/solver/World.hpp"
 #include "TestScenes.hpp"
@@ -66,7 +67,7 @@ TEST(Colliders, FixedPairsAreNeverProposed) {
 	world.addBlock(orientedBox(Vector3(0, 1, 0), Vector3(0.5, 0.5, 0.5), I), material, false);
 	const std::vector<Block> blocks = blocksOf(world);
 	std::unique_ptr<Collider> colliders[] = {std::make_unique<AllPairsCollider>(), std::make_unique<DESSCollider>(),
-	                                         std::make_unique<NBSCollider>()};
+	                                         std::make_unique<NBSCollider>(), std::make_unique<MSCCollider>()};
 	for (auto& collider : colliders) {
 		std::vector<std::pair<int, int>> pairs;
 		BroadPhaseStatistics stats;

@@ -309,18 +309,6 @@ TEST(MSCCollider, FixedBlocksShellsAreBuiltOnceAndFixedPairsNeverProposed) {
 	msc.findPairs(more, 0.05, pairs, stats);
 	EXPECT_EQ(msc.coverBuilds(), static_cast<long>(2 * blocks.size() + 1));
 	EXPECT_EQ(stats.shellUpdates, allShells + msc.shellCount(static_cast<int>(blocks.size())));
-
-	// Two fixed cubes side by side and a free one beside both.
-	World world;
-	Material material;
-	const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
-	world.addBlock(orientedBox(Vector3(0, 0, 0), Vector3(0.5, 0.5, 0.5), I), material, true);
-	world.addBlock(orientedBox(Vector3(1, 0, 0), Vector3(0.5, 0.5, 0.5), I), material, true);
-	world.addBlock(orientedBox(Vector3(0, 1, 0), Vector3(0.5, 0.5, 0.5), I), material, false);
-	MSCCollider small;
-	small.findPairs(blocksOf(world), 0.1, pairs, stats);
-	const std::vector<std::pair<int, int>> expected{{0, 2}, {1, 2}};
-	EXPECT_EQ(pairs, expected);
 }
 
 TEST(MSCCollider, StatisticsAndLinkedSetsOfEveryStrategy) {
