@@ -110,7 +110,7 @@ struct Scratch {
 	std::vector<int> used, faceEdges;
 	std::vector<Vector3> pointsA, pointsB;
 	std::vector<int> identity;  // 0, 1, 2, ...: "every sub-unit"
-	std::vector<char> vertexLinked[2], edgeLinked[2];
+	std::vector<char> vertexLinked[2];
 };
 
 Scratch& scratch() {
@@ -141,14 +141,12 @@ struct Prepared {
 	Vector3 lower = Vector3::Zero(), upper = Vector3::Zero();  // bounding box [m]
 	const std::vector<char>* internalFaces = nullptr;
 	// The sub-units the narrow phase may use (all, or those a broad phase
-	// linked to the pair), and per corner and edge whether it is one of them.
+	// linked to the pair), and per corner whether it is one of them.
 	Indices vertexList, edgeList, faceList;
 	const char* vertexLinked = nullptr;  // nullptr: every corner
-	const char* edgeLinked = nullptr;    // nullptr: every edge
 	long* tests = nullptr;               // vertex-face and edge-edge tests made
 
 	bool linkedVertex(int v) const { return !vertexLinked || vertexLinked[v]; }
-	bool linkedEdge(int e) const { return !edgeLinked || edgeLinked[e]; }
 
 	// A face covered by a coplanar face of a neighbouring fixed block: never an
 	// entrance, and its edges give no edge axes.
@@ -716,7 +714,7 @@ void prepareSubUnits(Prepared& p, const LinkedSubUnits* linked, int slot, Scratc
 		p.vertexList = {identity.data(), corners};
 		p.edgeList = {identity.data(), edges};
 		p.faceList = {identity.data(), faces};
-		p.vertexLinked = p.edgeLinked = nullptr;
+		p.vertexLinked = nullptr;
 		return;
 	}
 	const auto list = [](const std::vector<int>& v) { return Indices{v.data(), static_cast<int>(v.size())}; };
@@ -726,11 +724,7 @@ void prepareSubUnits(Prepared& p, const LinkedSubUnits* linked, int slot, Scratc
 	std::vector<char>& vertexMark = s.vertexLinked[slot];
 	vertexMark.assign(corners, 0);
 	for (int v : linked->vertices[slot]) vertexMark[v] = 1;
-	std::vector<char>& edgeMark = s.edgeLinked[slot];
-	edgeMark.assign(edges, 0);
-	for (int e : linked->edges[slot]) edgeMark[e] = 1;
 	p.vertexLinked = vertexMark.data();
-	p.edgeLinked = edgeMark.data();
 }
 
 }  // namespace
