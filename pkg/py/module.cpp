@@ -240,11 +240,13 @@ py::dict lastStep(const SceneLink& s) {
 	d["openCloseIterations"] = st.openCloseIterations;
 	d["openCloseIterationsTotal"] = st.openCloseIterationsTotal;
 	d["stateChanges"] = st.stateChanges;
+	d["normalForceUpdates"] = st.normalForceUpdates;
 	d["openCloseCuts"] = st.openCloseCuts;
 	d["openCloseFailures"] = st.openCloseFailures;
 	d["maxPenetration"] = st.maxPenetration;
 	d["components"] = st.components;
 	d["largestComponent"] = st.largestComponent;
+	d["systemStructures"] = st.systemStructures;
 	py::dict times;
 	times["broadPhase"] = st.timeBroadPhase;
 	times["narrowPhase"] = st.timeNarrowPhase;

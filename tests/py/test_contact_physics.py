@@ -524,6 +524,37 @@ def test_block_rests_on_floor(scene):
     assert S.norm(S.sub(f, (0.0, 0.0, mass * G))) < 1e-3 * mass * G
 
 
+@pytest.mark.parametrize('phiDeg', [15.0, 30.0])
+def test_block_launched_along_floor_slides_to_a_stop(scene, phiDeg):
+    """A 1 m cube resting on a floor, launched at v0 = 2 m/s along x, slides
+    with the deceleration g tan(phi) and stops after v0^2 / (2 g tan(phi)).
+
+    What could go wrong: its contacts with the floor are new at the first
+    step and start locked; a spring holding the whole first step's slip tips
+    the cube, the tipped solve's normal force (many times the weight) drives
+    the friction of the next one, the cube loses 40% of its speed in one
+    step and hops to a stop after 3 mm (where it should slide 0.35 m at 30
+    deg). Checked: the speed at t = 0.1 s to 1e-4 of v0, the stopping
+    distance to 1e-3 (it stops within one step of dt v0 = 4 mm, so the
+    distance is exact to dt^2 terms), no lift-off (the centroid stays at
+    0.5 m to the elastic settling), the cube does not turn, and it is at rest
+    but for its shear springs ringing down after the stop.
+    """
+    v0, mu = 2.0, math.tan(math.radians(phiDeg))
+    floor, block = S.build_resting_block(frictionDeg=phiDeg)
+    O.bodies[block].state.vel = (v0, 0, 0)
+    O.engines = [integrator(dt=1e-3)]
+    c0 = centroid(block)
+    run_to(0.1)
+    assert abs(yade_dda.block(block).velocity[0] - (v0 - G * mu * O.time)) < 1e-4 * v0
+    run_to(v0 / (G * mu) + 0.05)
+    c = centroid(block)
+    assert abs((c[0] - c0[0]) - v0 * v0 / (2 * G * mu)) < 1e-3 * v0 * v0 / (2 * G * mu)
+    assert abs(c[2] - c0[2]) < 1e-5 and abs(c[1] - c0[1]) < 1e-9
+    assert yade_dda.block(block).rotation.toRotationVector().norm() < 1e-5
+    assert S.norm(yade_dda.block(block).velocity[0:3]) < 1e-4 * v0   # at rest but for the shear springs' ringing
+
+
 def test_tower_of_ten_cubes_stands(scene):
     """Ten identical 1 m cubes stacked with exactly coincident corners on a fixed floor stand for 5 s.
 

@@ -174,13 +174,6 @@ NARROW_PHASE_LINE_CONTACT = pytest.mark.xfail(strict=True, reason=(
     'when the edge lies almost in a face of the other block (a line contact, here the lower cube\'s edge '
     'along the upper cube\'s face, 1e-3 rad apart); the edge\'s end corner (the apex) is no contact and '
     'sinks 1.76e-4 m into that face at step 345 (tolerance 1.42e-4 m), then is thrown out (3300 J lost)'))
-FRICTION_SWITCH_CAP = pytest.mark.xfail(strict=True, reason=(
-    'core fault, open-close iteration (World::step): after kFrictionSwitchesCounted switches a contact\'s '
-    'sliding/locked switch still changes its state but no longer counts as a change, so the step is '
-    'accepted with a solve made for the state it just left: a sliding contact whose motion reversed ends '
-    'locked with a shear spring stretched by the whole step\'s slip (|S| = 6.5e7 N vs tan(phi) N = 1.1e4 N) '
-    'and the friction load of that solve pushed along the motion: energy gain'))
-
 CORNER_DROPS = ['aligned', 'apex', pytest.param('apex-turned', marks=NARROW_PHASE_LINE_CONTACT)]
 
 
@@ -214,8 +207,7 @@ def test_corner_dropped_exactly_on_corner(scene, placement):
 
 
 EDGE_CROSSINGS = {'90deg': math.pi / 2, '30deg': math.radians(30)}
-NEAR_PARALLEL = [pytest.param(t, id='%g' % t, marks=FRICTION_SWITCH_CAP if t == 1e-8 else ())
-                 for t in (1e-2, 1e-4, 1e-6, 1e-8, 0.0)]
+NEAR_PARALLEL = [pytest.param(t, id='%g' % t) for t in (1e-2, 1e-4, 1e-6, 1e-8, 0.0)]
 
 
 def edge_on_edge(theta, gap=0.02):
@@ -265,7 +257,7 @@ def test_near_parallel_edges(scene, theta):
     assert guard.worstPenetration > 0
 
 
-STACKS = ['aligned', pytest.param('offset', marks=FRICTION_SWITCH_CAP), 'turned45', 'turned1e-9']
+STACKS = ['aligned', 'offset', 'turned45', 'turned1e-9']
 
 
 @pytest.mark.parametrize('kind', STACKS)
@@ -574,7 +566,7 @@ def test_wedge_at_factor_of_safety_one(scene, fs):
 
 # ================================================================ long run, threads
 
-STACK_TILTS = [0.0, pytest.param(10.0, marks=FRICTION_SWITCH_CAP)]
+STACK_TILTS = [0.0, 10.0]
 
 
 @pytest.mark.slow

@@ -79,6 +79,21 @@ void startTrial(Contact& contact, bool formBonds) {
 	if (!contact.normal.valid) contact.trial.state = ContactState::Open;
 }
 
+bool startSlidingIfMoving(Contact& contact, const Block& blockI, const Block& blockJ, const Vector12& Vi,
+                          const Vector12& Vj, double dt) {
+	ContactHistory& trial = contact.trial;
+	if (!contact.isNew || trial.state != ContactState::Locked || trial.bonded) return false;
+	const Vector3 velocity = displacementAt(contact.geometry.pointI - blockI.centroid, Vi) -
+	                         displacementAt(contact.geometry.pointJ - blockJ.centroid, Vj);
+	const Vector3 tangential = tangentProjector(contact.geometry.normal) * velocity;
+	const double speed = tangential.norm();
+	if (!(contact.shearStiffness * speed * dt > contact.frictionTangent * std::max(0.0, trial.normalForce)))
+		return false;
+	trial.state = ContactState::Sliding;
+	trial.slidingDirection = tangential / speed;
+	return true;
+}
+
 double contactGap(const Contact& contact, const Vector12& Di, const Vector12& Dj) {
 	return contact.normal.d0 + contact.normal.ei.dot(Di) + contact.normal.ej.dot(Dj);
 }
@@ -119,8 +134,19 @@ bool updateContactState(Contact& contact, const Block& blockI, const Block& bloc
 	const Vector3& n = contact.geometry.normal;
 
 	if (!closed(before)) {
-		if (gap < 0) close(contact);
-	} else if (gap > openTolerance) {
+		if (!(gap < 0)) return false;
+		// A contact that closes is locked (sliding if nothing can lock it)
+		// for the next solve, whatever this solve's tangential motion: its
+		// normal force and shear are known only from a solve with it closed.
+		// Judged now, against -kn x the gap of a solve without the contact (a
+		// fictitious force, easily 100 x the weight), that force drove a
+		// friction load that lifted the block open again, and the iteration
+		// cycled (near-parallel edges, tests/py/test_hard_cases.py).
+		close(contact);
+		trial.normalForce = normalForce(contact, gap);
+		return true;
+	}
+	if (gap > openTolerance) {
 		// A bond holds in tension up to its strength; beyond, it breaks.
 		if (!(trial.bonded && contact.normalStiffness * gap <= contact.tensileForce)) {
 			trial.state = ContactState::Open;

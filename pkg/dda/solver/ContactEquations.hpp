@@ -78,4 +78,15 @@ void finishContact(Contact& contact, const Block& blockI, const Block& blockJ, c
 // bonded joint.
 void startTrial(Contact& contact, bool formBonds);
 
+// A new contact that startTrial locked, between blocks whose start rates Vi,
+// Vj [m/s, rad/s, 1/s] move its points apart tangentially, starts sliding
+// along that motion instead when its shear spring would exceed the friction
+// capacity within the step: ks |v_t| dt > tan(phi) N (always, for a contact
+// that only touches: N = 0). A locked spring on a block arriving with
+// tangential speed holds the whole step's slip (a 1 m cube sliding at 2 m/s
+// lost 40% of its speed in its first step, tipped by the spring, and hopped).
+// Bonded contacts stay locked. Returns whether the state changed.
+bool startSlidingIfMoving(Contact& contact, const Block& blockI, const Block& blockJ, const Vector12& Vi,
+                          const Vector12& Vj, double dt);
+
 }  // namespace dda

@@ -1,12 +1,13 @@
 // The global DDA system K D = F of the moving blocks, block-sparse: a 12x12
 // diagonal block per moving block, and an off-diagonal block per pair of
-// moving blocks joined by at least one contact (open or not: the open-close
-// iteration may close it). Blocks that no contact joins form independent
+// moving blocks joined by at least one closed contact (open contacts carry no
+// terms; World rebuilds the structure when the open-close iteration opens or
+// closes one). Blocks that no closed contact joins form independent
 // components, each solved on its own:
 //   - one block without contacts or fixed points: the block's own 3 + 9 solve
 //     (BlockEquations.hpp), so a free block is not affected by the rest of
 //     the scene, not even by round-off;
-//   - one block with contacts (against fixed blocks) or fixed points: a dense
+//   - one block with closed contacts (against fixed blocks) or fixed points: a dense
 //     12x12 Cholesky;
 //   - several blocks: a sparse Cholesky (Eigen's SimplicialLLT, AMD order).
 // K is symmetric positive definite: the mass term is, and springs add
@@ -26,9 +27,10 @@ namespace dda {
 
 class CoupledSystem {
 public:
-	// Sets the structure for a step: `links` lists pairs of moving-block
-	// indices (0 .. movingBlocks-1) joined by a contact; `hasSprings[k]` says
-	// whether block k has contacts or fixed points (so needs the 12x12 solve).
+	// Sets the structure: `links` lists pairs of moving-block indices
+	// (0 .. movingBlocks-1) joined by a closed contact; `hasSprings[k]` says
+	// whether block k has closed contacts or fixed points (so needs the 12x12
+	// solve).
 	void build(int movingBlocks, const std::vector<std::pair<int, int>>& links, const std::vector<char>& hasSprings);
 
 	// Starts an assembly from the blocks' own systems.

@@ -94,11 +94,13 @@ struct StepStatistics {
 	int openCloseIterations = 0;     // solves in the accepted attempt
 	int openCloseIterationsTotal = 0;  // solves in all attempts of the step
 	int stateChanges = 0;            // contact state changes in the accepted attempt
+	int normalForceUpdates = 0;      // solves made only because sliding contacts' normal forces had not settled (all attempts)
 	int openCloseCuts = 0;           // dt cuts because the iteration did not converge
 	long openCloseFailures = 0;      // steps accepted unconverged after maxStepCuts (cumulative)
 	double maxPenetration = 0;       // deepest closed contact at the end of the step [m]
-	int components = 0;              // independent systems solved (moving blocks coupled by contacts)
+	int components = 0;              // independent systems of the last solve (moving blocks joined by closed contacts)
 	int largestComponent = 0;        // blocks in the largest one
+	int systemStructures = 0;        // times the system's structure was built (first solve, then after openings/closings)
 	// wall time per phase [s]
 	double timeBroadPhase = 0;
 	double timeNarrowPhase = 0;

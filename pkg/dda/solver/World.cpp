@@ -33,6 +33,11 @@ constexpr double kCornerMergeFraction = 1e-3;
 constexpr double kMaxParallelAngleTolerance = 0.05;
 // Sliding/locked switches of one contact that keep an open-close iteration going (see step()).
 constexpr int kFrictionSwitchesCounted = 2;
+// Sliding contacts' normal forces have settled when a solve changes each by at
+// most this fraction of the largest normal force (the friction load lags N by
+// one solve); solves of a step that may be spent on settling them.
+constexpr double kNormalForceTolerance = 1e-4;
+constexpr int kNormalForceSolves = 6;
 double secondsSince(Clock::time_point start) {
 	return std::chrono::duration<double>(Clock::now() - start).count();
 }
@@ -248,6 +253,12 @@ void World::setCollider(std::unique_ptr<Collider> collider) {
 	collider_ = std::move(collider);
 }
 
+const Vector12& World::startRates(int block) const {
+	static const Vector12 zero = Vector12::Zero();
+	const int k = movingIndex_[block];
+	return k < 0 ? zero : startVelocities_[k];
+}
+
 const Vector12& World::unknowns(int block) const {
 	static const Vector12 zero = Vector12::Zero();
 	const int k = movingIndex_[block];
@@ -330,6 +341,23 @@ void World::detectContacts(const IntegratorSettings& settings, StepStatistics& s
 	stats.timeNarrowPhase = secondsSince(phase);
 }
 
+void World::buildSystemStructure(int movingBlocks, StepStatistics& stats) {
+	links_.clear();
+	hasSprings_.assign(movingBlocks, 0);
+	for (int k = 0; k < movingBlocks; ++k) hasSprings_[k] = !blocks_[moving_[k]].fixedPoints.empty();
+	for (const Contact& contact : store_.contacts()) {
+		if (contact.trial.state == ContactState::Open) continue;  // no terms: couples nothing
+		const int mi = movingIndex_[contact.key.blockI], mj = movingIndex_[contact.key.blockJ];
+		if (mi >= 0) hasSprings_[mi] = 1;
+		if (mj >= 0) hasSprings_[mj] = 1;
+		if (mi >= 0 && mj >= 0) links_.emplace_back(mi, mj);
+	}
+	coupled_.build(movingBlocks, links_, hasSprings_);
+	++stats.systemStructures;
+	stats.components = coupled_.components();
+	stats.largestComponent = coupled_.largestComponent();
+}
+
 void World::assembleContacts() {
 	Matrix24 stiffness;
 	Vector24 force;
@@ -386,20 +414,6 @@ double World::step(const IntegratorSettings& settings) {
 	detectContacts(settings, stats);
 	std::vector<Contact>& contacts = store_.contacts();
 
-	// Structure of the global system: which moving blocks contacts join.
-	std::vector<std::pair<int, int>> links;
-	std::vector<char> hasSprings(n, 0);
-	for (int k = 0; k < n; ++k) hasSprings[k] = !blocks_[moving_[k]].fixedPoints.empty();
-	for (const Contact& contact : contacts) {
-		const int mi = movingIndex_[contact.key.blockI], mj = movingIndex_[contact.key.blockJ];
-		if (mi >= 0) hasSprings[mi] = 1;
-		if (mj >= 0) hasSprings[mj] = 1;
-		if (mi >= 0 && mj >= 0) links.emplace_back(mi, mj);
-	}
-	coupled_.build(n, links, hasSprings);
-	stats.components = coupled_.components();
-	stats.largestComponent = coupled_.largestComponent();
-
 	const double openTolerance = settings.openCloseTolerance * stats.allowedDisplacement;
 	double dt = nextTimeStep_ > 0 ? std::min(nextTimeStep_, settings.maxTimeStep) : settings.maxTimeStep;
 
@@ -414,11 +428,15 @@ double World::step(const IntegratorSettings& settings) {
 		for (Contact& contact : contacts) {
 			startTrial(contact, steps_ == 0);
 			contact.frictionSwitches = 0;
+			const int bi = contact.key.blockI, bj = contact.key.blockJ;
+			startSlidingIfMoving(contact, blocks_[bi], blocks_[bj], startRates(bi), startRates(bj), dt);
 		}
-		bool converged = false;
+		bool converged = false, structureStale = true;
 		int iterations = 0, changes = 0;
 		while (iterations < std::max(1, settings.maxOpenCloseIterations)) {
 			phase = Clock::now();
+			if (structureStale) buildSystemStructure(n, stats);
+			structureStale = false;
 			coupled_.reset(systems_);
 			assembleContacts();
 			stats.timeAssembly += secondsSince(phase);
@@ -427,19 +445,57 @@ double World::step(const IntegratorSettings& settings) {
 			stats.timeSolve += secondsSince(phase);
 			++iterations;
 			changes = 0;
+			double normalForceChange = 0, largestNormalForce = 0;
 			for (Contact& contact : contacts) {
 				const int bi = contact.key.blockI, bj = contact.key.blockJ;
-				const ContactState before = contact.trial.state;
-				if (!updateContactState(contact, blocks_[bi], blocks_[bj], unknowns(bi), unknowns(bj), openTolerance))
+				const ContactHistory before = contact.trial;
+				if (contact.trial.state != ContactState::Open)
+					largestNormalForce = std::max(largestNormalForce, std::abs(contact.trial.normalForce));
+				if (!updateContactState(contact, blocks_[bi], blocks_[bj], unknowns(bi), unknowns(bj), openTolerance)) {
+					if (contact.trial.state == ContactState::Sliding && contact.frictionTangent > 0)
+						normalForceChange = std::max(normalForceChange,
+						                             std::abs(contact.trial.normalForce - before.normalForce));
 					continue;
-				// A closed contact that keeps switching between sliding and locked
-				// within one step sits on the friction limit, where round-off
-				// decides. After kFrictionSwitchesCounted such switches its latest
-				// state stands and further switches no longer hold the iteration
-				// open. Opening and closing always count.
-				const bool frictionSwitch = before != ContactState::Open && contact.trial.state != ContactState::Open;
-				if (frictionSwitch && ++contact.frictionSwitches > kFrictionSwitchesCounted) continue;
+				}
+				const bool frictionSwitch =
+				    before.state != ContactState::Open && contact.trial.state != ContactState::Open;
+				if (!frictionSwitch) {
+					// Opening and closing always count, and change which blocks
+					// the system couples (only closed contacts carry terms).
+					structureStale = true;
+					++changes;
+					continue;
+				}
+				// A closed contact that keeps switching between sliding and
+				// locked within one step sits on the friction limit, where
+				// round-off decides. After kFrictionSwitchesCounted switches it
+				// stays locked: a switch back to sliding is undone, so the state
+				// is the one the last solve was made for (accepting the switch
+				// unsolved would load the step with friction along a motion
+				// that reversed, creating energy); a switch to locked counts,
+				// and one more solve is made for it. A locked spring stores
+				// energy and never creates it; any excess over the friction
+				// limit is released by the next step, which starts locked and
+				// slides.
+				if (contact.frictionSwitches >= kFrictionSwitchesCounted &&
+				    contact.trial.state == ContactState::Sliding) {
+					contact.trial = before;
+					continue;
+				}
+				++contact.frictionSwitches;
 				++changes;
+			}
+			// A sliding contact's friction load tan(phi) N used the normal
+			// force of the solve before. A solve with springs locked can tip a
+			// block and give N many times its weight, so the iteration goes on
+			// while a sliding contact's N changes by more than a fraction of
+			// the largest normal force, for at most kNormalForceSolves solves:
+			// a lagging N changes how much friction resists, never its
+			// direction against the sliding, so it cannot create energy.
+			if (changes == 0 && iterations < kNormalForceSolves &&
+			    normalForceChange > kNormalForceTolerance * largestNormalForce) {
+				++stats.normalForceUpdates;
+				continue;
 			}
 			if (changes == 0) {
 				converged = true;

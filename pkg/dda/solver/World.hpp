@@ -48,9 +48,14 @@ private:
 	void validateSettings(const IntegratorSettings& settings) const;
 	// Broad and narrow phase; fills store_ with this step's sub-contacts.
 	void detectContacts(const IntegratorSettings& settings, StepStatistics& stats);
+	// The global system's structure from the contacts' trial states: only
+	// closed contacts carry terms, so only they join blocks into components
+	// (an open contact within d0 couples nothing until it closes).
+	void buildSystemStructure(int movingBlocks, StepStatistics& stats);
 	// Adds the trial-state terms of every contact to coupled_.
 	void assembleContacts();
 	const Vector12& unknowns(int block) const;
+	const Vector12& startRates(int block) const;  // rates at the start of the step, zero for fixed blocks
 	std::unique_ptr<Collider> collider_ = std::make_unique<DESSCollider>();
 	ContactStore store_;
 	CoupledSystem coupled_;
@@ -66,6 +71,8 @@ private:
 	std::vector<std::vector<char>> internalFaces_;
 	int internalFacesBlocks_ = -1;  // block count when internalFaces_ was computed
 	std::vector<Vector3> points_;
+	std::vector<std::pair<int, int>> links_;  // buildSystemStructure's work arrays
+	std::vector<char> hasSprings_;
 	std::vector<Block> blocks_;
 	StepStatistics stats_;
 	double nextTimeStep_ = 0;  // dt to try first in the next step; 0 = maxTimeStep
