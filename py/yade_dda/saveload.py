@@ -73,7 +73,7 @@ def decodeState(text):
     try:
         compressed = base64.b64decode(body.encode('ascii'), validate=True)
     except (binascii.Error, UnicodeEncodeError, ValueError) as error:
-        raise ValueError('%s is corrupt: not base64 (%s)' % (where, error)) from None
+        raise ValueError('%s is truncated or corrupt: not base64 (%s)' % (where, error)) from None
     try:
         raw = zlib.decompress(compressed)
     except zlib.error as error:
