@@ -17,7 +17,7 @@ from .blocks import ddaBlock
 from .engines import DDAIntegrator
 from .colliders import MSCCollider, DESSCollider, NBSCollider, AllPairsCollider
 from .compare import compareColliders
-from .saveload import Checkpoint, latestCheckpoint, storeState, restoreState
+from .saveload import Checkpoint, latestCheckpoint, writeCheckpoint, storeState, restoreState
 from .scene import (stats, sync, block, blockOf, setVelocity, addPointLoad, addFixedPoint,
                     printStats, contacts, Ig2_DDABlock_DDABlock_DDAContact)
 
