@@ -10,6 +10,7 @@
 
 #include <Eigen/Geometry>
 
+#include <string>
 #include <unordered_map>
 #include <vector>
 
@@ -43,6 +44,12 @@ public:
 	double sceneHalfSize() { return world.sceneHalfSize(); }
 	double time() const { return world.time(); }
 	long steps() const { return world.steps(); }
+
+	// The whole scene (world and body links) as a framed binary state
+	// (dda/solver/StateStream.hpp), and back. loadState throws StateError
+	// naming the problem and leaves this scene unchanged.
+	std::string saveState() const;
+	void loadState(const std::string& state);
 
 private:
 	std::vector<BodyLink> links_;  // per block; bodyId -1 until linked

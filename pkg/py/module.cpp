@@ -263,6 +263,16 @@ py::object bodyToBlock(const SceneLink& s, int bodyId) {
 	return block < 0 ? py::object() : py::object(block);
 }
 
+// The scene's saved state as bytes (SceneLink::saveState), and back.
+py::object saveState(const SceneLink& s) {
+	const std::string state = s.saveState();
+	return py::object(py::handle<>(PyBytes_FromStringAndSize(state.data(), static_cast<Py_ssize_t>(state.size()))));
+}
+void loadState(SceneLink& s, const py::object& state) {
+	if (!PyBytes_Check(state.ptr())) throw InputError("a saved DDA state must be bytes");
+	s.loadState(std::string(PyBytes_AS_STRING(state.ptr()), static_cast<std::size_t>(PyBytes_GET_SIZE(state.ptr()))));
+}
+
 }  // namespace
 
 BOOST_PYTHON_MODULE(_core) {
@@ -328,5 +338,8 @@ BOOST_PYTHON_MODULE(_core) {
 	    .def("lastStep", &lastStep)
 	    .def("sceneHalfSize", &SceneLink::sceneHalfSize)
 	    .def("time", &SceneLink::time)
-	    .def("steps", &SceneLink::steps);
+	    .def("steps", &SceneLink::steps)
+	    .def("saveState", &saveState, "The whole DDA scene (blocks, contacts and their history, counters) as bytes.")
+	    .def("loadState", &loadState,
+	         "Replaces this scene by a state from saveState; ValueError naming the problem (and no change) if it cannot.");
 }

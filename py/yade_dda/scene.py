@@ -94,22 +94,40 @@ class DDAScene:
         self.syncs += 1
 
 
+def newToken():
+    return uuid.uuid4().hex
+
+
+def register(scene):
+    """Makes scene the DDA scene of the current YADE scene."""
+    _scenes[scene.token] = scene
+    O.tags[TAG] = scene.token
+
+
+def drop(token):
+    """Forgets a DDA scene (its YADE scene was replaced by O.load)."""
+    _scenes.pop(token, None)
+
+
 def current(create=True):
-    """The DDA scene of the current YADE scene (made on demand when create)."""
-    try:
-        token = O.tags[TAG]
-    except KeyError:
-        token = None
-    if token is not None and token in _scenes:
+    """The DDA scene of the current YADE scene (made on demand when create).
+
+    A YADE scene loaded with DDA blocks whose core scene this process does not
+    hold (loaded before yade_dda was imported) is restored from its saved DDA
+    state (yade_dda.saveload)."""
+    token = O.tags[TAG] if TAG in O.tags.keys() else None
+    if token and token in _scenes:
         return _scenes[token]
-    if token is not None:
-        raise RuntimeError('this YADE scene holds DDA state from another session (loaded from a file?); '
-                           'restoring DDA blocks with O.load() is not supported yet')
+    if token:
+        from . import saveload
+        try:
+            return saveload.restoreState()
+        except ValueError as error:
+            raise RuntimeError('this YADE scene holds DDA blocks whose DDA state cannot be restored: %s' % error) from None
     if not create:
         return None
-    token = uuid.uuid4().hex
-    O.tags[TAG] = token
-    scene = _scenes[token] = DDAScene(token)
+    scene = DDAScene(newToken())
+    register(scene)
     return scene
 
 

@@ -17,6 +17,9 @@
 
 namespace dda {
 
+class StateWriter;
+class StateReader;
+
 // Bounding volumes are widened by this x the contact distance d0 on every
 // side, so two volumes meet whenever the blocks are within 2 d0. The narrow
 // phase accepts a corner within d0 of a face's plane whose projection falls
@@ -50,6 +53,11 @@ public:
 	// (its index in `pairs`), or nullptr: strategies without sub-block volumes
 	// link every sub-unit. Valid until the next findPairs.
 	virtual const LinkedSubUnits* linked(int /*pairIndex*/) const { return nullptr; }
+	// Saving: state kept from call to call that changes later results (MSC's
+	// covers); caches rebuilt identically from the blocks need not be saved.
+	// readState gets the restored blocks (StateError on bad data).
+	virtual void writeState(StateWriter& /*out*/) const {}
+	virtual void readState(StateReader& /*in*/, const std::vector<Block>& /*blocks*/) {}
 };
 
 // Every pair of blocks that are not both fixed: O(n^2), the reference.

@@ -82,6 +82,12 @@ public:
 	// Topology builds (block covers) since construction.
 	long coverBuilds() const { return coverBuilds_; }
 
+	// Saving (MSCColliderState.cpp): parameters, overrides and every block's
+	// cover as built (a cover is built from the block's geometry at that
+	// time, so rebuilding it later would give other slabs).
+	void writeState(StateWriter& out) const override;
+	void readState(StateReader& in, const std::vector<Block>& blocks) override;
+
 private:
 	struct DivisionPoint {
 		int edge;

@@ -118,6 +118,13 @@ void ContactStore::setEntrance(int a, int b, const EntranceFeature& entrance) {
 	entrances_[pairKey(a, b)] = entrance;
 }
 
+void ContactStore::restore(std::vector<Contact> contacts,
+                           std::unordered_map<std::uint64_t, EntranceFeature> entrances) {
+	clear();
+	current_ = std::move(contacts);
+	entrances_ = std::move(entrances);
+}
+
 void ContactStore::clear() {
 	current_.clear();
 	previous_.clear();

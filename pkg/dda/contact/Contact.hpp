@@ -100,6 +100,11 @@ public:
 
 	void clear();
 
+	// Saving (solver/WorldState.cpp): the current contacts and entrance
+	// features are all a store carries into the next step.
+	const std::unordered_map<std::uint64_t, EntranceFeature>& entrances() const { return entrances_; }
+	void restore(std::vector<Contact> contacts, std::unordered_map<std::uint64_t, EntranceFeature> entrances);
+
 private:
 	std::vector<Contact> current_;
 	std::vector<Contact> previous_;

@@ -15,6 +15,9 @@
 
 namespace dda {
 
+class StateWriter;
+class StateReader;
+
 class World {
 public:
 	// Builds and validates a block (throws InputError; the world is unchanged then).
@@ -43,6 +46,14 @@ public:
 	// Half the largest extent of the bounding box of all blocks [m] (Shi's w0),
 	// measured at the first step after blocks were added.
 	double sceneHalfSize();
+
+	// Saving (WorldState.cpp): writes every member that affects later steps,
+	// in container order (contact order decides summation order, hence
+	// round-off), so a restored world continues bitwise as this one would.
+	// readState replaces this world's state, or throws StateError and leaves
+	// it unchanged.
+	void writeState(StateWriter& out) const;
+	void readState(StateReader& in);
 
 private:
 	void validateSettings(const IntegratorSettings& settings) const;
