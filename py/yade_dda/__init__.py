@@ -17,9 +17,10 @@ from .blocks import ddaBlock
 from .engines import DDAIntegrator
 from .colliders import MSCCollider, DESSCollider, NBSCollider, AllPairsCollider
 from .compare import compareColliders
+from .accuracy import sweep
 from .scene import (stats, sync, block, blockOf, setVelocity, addPointLoad, addFixedPoint,
                     printStats, contacts, Ig2_DDABlock_DDABlock_DDAContact)
 
 __all__ = ['ddaBlock', 'DDAIntegrator', 'MSCCollider', 'DESSCollider', 'NBSCollider', 'AllPairsCollider',
-           'compareColliders', 'stats', 'printStats', 'sync', 'block', 'blockOf',
+           'compareColliders', 'sweep', 'stats', 'printStats', 'sync', 'block', 'blockOf',
            'setVelocity', 'addPointLoad', 'addFixedPoint', 'contacts', 'Ig2_DDABlock_DDABlock_DDAContact', 'O']
