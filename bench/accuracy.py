@@ -19,11 +19,13 @@ g = 9.81 m/s^2, simulated time tEnd = 1 s, --quick 0.3 s):
                   equilibrium, Hoek & Bray). Error: |s - s_exact| [m] along the keel,
                   s_exact = g sin(psi) (1 - FS) t^2/2.
   bounce          1 m cube (E = 100 MPa, so the impact lasts about 2.5 ms) dropped flat
-                  from 0.2 m onto a fixed floor, no friction. Physically elastic: the
-                  energy stays m g h. Error: energy dissipated by tEnd over the drop energy
-                  (E0 - E(tEnd)) / (m g h) [-], E = kinetic + gravity + strain + contact
+                  from h = 0.05 m onto a fixed floor, no friction. Physically elastic: the
+                  block rebounds with all of m g h. Error: the energy the first impact
+                  dissipated over the drop energy, (E0 - E_sep) / (m g h) [-], E_sep at
+                  the first step after the impact with no closed contact (1 if the block
+                  never leaves the floor), E = kinetic + gravity + strain + contact
                   springs, evaluated every step; the largest gain over E0 is recorded too
-                  (DDA must never create energy).
+                  (DDA must never create energy), and the dissipation by tEnd.
 
 Knobs (DDAIntegrator / MSCCollider parameters): dt [s], maxDisplacementRatio [-]
 (with maxDisplacement = 0 and dt = 1e-2 s, so the displacement control sets the
@@ -64,7 +66,7 @@ ROCK = dict(young=1e10, poisson=0.25, density=2600.0)
 PLAN = {
     'dt': dict(full=[1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2e-4, 1e-4], quick=[1e-2, 3e-3, 1e-3],
                scenes=['freefall', 'incline_smooth', 'incline_friction', 'wedge', 'bounce'], base={}),
-    'maxDisplacementRatio': dict(full=[0.03, 0.01, 3e-3, 1e-3, 3e-4], quick=[0.01, 1e-3],
+    'maxDisplacementRatio': dict(full=[0.03, 0.01, 3e-3, 1e-3, 3e-4, 1e-4], quick=[0.01, 1e-3],
                                  scenes=['incline_friction', 'wedge', 'bounce'],
                                  base=dict(dt=1e-2, maxDisplacement=0.0)),
     'contactPenaltyFactor': dict(full=[1, 3, 10, 40, 100, 300, 1000], quick=[4, 40, 400],
@@ -76,7 +78,7 @@ PLAN = {
     'segments': dict(full=[1, 2, 3, 6, 12], quick=[1, 6], scenes=['incline_friction', 'wedge'], base={}),
 }
 MSC_KNOBS = ('criticalLength', 'segments')
-YADE_FRACTIONS = dict(full=[1.0, 0.5, 0.2, 0.1], quick=[0.5, 0.2])
+YADE_FRACTIONS = dict(full=[1.0, 0.5, 0.2, 0.1, 0.05], quick=[0.5, 0.2])
 YADE_SCENES = dict(full=['incline_friction', 'incline_smooth'], quick=['incline_friction'])
 
 
@@ -245,7 +247,7 @@ def _wedgeMeasure(ctx):
                 offKeel=off, phiPlanesDeg=ctx['phiDeg'])
 
 
-BOUNCE = dict(drop=0.2, young=1e8)
+BOUNCE = dict(drop=0.05, young=1e8)
 
 
 def _bounceBuild(ctx, maxDisplacement):
@@ -266,8 +268,8 @@ class _EnergyMonitor:
         self.ctx = ctx
         self.e0 = None
         self.maxGain = -math.inf
-        self.minEnergy = math.inf
         self.kn = None
+        self.phase, self.atSeparation, self.separationTime = 'falling', None, None
 
     def energy(self):
         import numpy
@@ -299,14 +301,17 @@ class _EnergyMonitor:
         return kinetic + gravity + strain + springs
 
     def __call__(self):
+        import yade_dda
         e = self.energy()
         if self.e0 is None:
             self.e0 = e
         self.maxGain = max(self.maxGain, e - self.e0)
-        self.minEnergy = min(self.minEnergy, e)
         self.last = e
-
-
+        closed = any(c.state != 'open' for c in yade_dda.contacts())
+        if self.phase == 'falling' and closed:
+            self.phase = 'impact'
+        elif self.phase == 'impact' and not closed:      # the first separation: what the impact kept
+            self.phase, self.atSeparation, self.separationTime = 'flight', e, yade_dda.O.time
 
 
 def _bounceMeasure(ctx):
@@ -318,10 +323,12 @@ def _bounceMeasure(ctx):
     # (kinetic + potential of a constant-acceleration step), so it equals m g (h + 0.5).
     expected0 = blk.mass * G * (BOUNCE['drop'] + 0.5)
     slack = 1e-9 * mgh
-    return dict(error=(mon.e0 - mon.last) / mgh, maxGain=mon.maxGain, maxGainRelative=mon.maxGain / mgh,
-                energyCreated=bool(mon.maxGain > slack), gainSlack=slack, dropEnergy=mgh,
-                firstStepEnergyError=(mon.e0 - expected0) / mgh, finalHeight=blk.centroid[2] - 0.5,
-                finalVerticalVelocity=blk.velocity[2])
+    lost = mon.e0 - (mon.atSeparation if mon.atSeparation is not None else mon.last)
+    return dict(error=lost / mgh, separated=mon.atSeparation is not None, separationTime=mon.separationTime,
+                dissipatedAtEnd=(mon.e0 - mon.last) / mgh, maxGain=mon.maxGain,
+                maxGainRelative=mon.maxGain / mgh, energyCreated=bool(mon.maxGain > slack), gainSlack=slack,
+                dropEnergy=mgh, firstStepEnergyError=(mon.e0 - expected0) / mgh,
+                finalHeight=blk.centroid[2] - 0.5, finalVerticalVelocity=blk.velocity[2])
 
 
 SCENES = {
@@ -337,7 +344,9 @@ SCENES = {
                            '|s - s_exact|: slide along the keel at tEnd, s_exact = g sin(psi) (1 - FS) t^2/2 '
                            '(psi = 35 deg, FS = 0.8)', 'm', 0.02),
     'bounce': lambda: Scene('bounce', _bounceBuild, _bounceMeasure,
-                            '(E0 - E(tEnd)) / (m g h): energy dissipated over the drop energy (elastic: 0)', '-',
+                            '(E0 - E_sep) / (m g h): energy the first impact dissipated over the drop energy, '
+                            'E_sep at the first step after it with no closed contact (elastic: 0; 1 when the '
+                            'block never leaves the floor by tEnd, then E_sep = E(tEnd))', '-',
                             0.02, monitor=_EnergyMonitor),
 }
 
@@ -351,7 +360,46 @@ def pWaveTimeStep(volume, young, density):
     return (3 * volume / (4 * math.pi)) ** (1 / 3.0) / math.sqrt(young / density)
 
 
-def yadeIncline(phiDeg, fraction, tEnd):
+class _YadeDiagnosis:
+    """Per-step record of the YADE incline's contact (untimed diagnostic run): the normal
+    force over m g cos(a), the shear force over tan(phi) x the normal force (1 = sliding),
+    the block's tilt and the fraction of steps with no force."""
+
+    def __init__(self, body, phiDeg):
+        from yade_dda import O
+        self.body, self.tanPhi = body, math.tan(math.radians(phiDeg))
+        self.weightNormal = O.bodies[body].state.mass * G * math.cos(math.radians(SLOPE_DEG))
+        self.n = self.zero = 0
+        self.normal = self.shear = self.shearMax = 0.0
+        self.normalMax, self.tiltMax = 0.0, 0.0
+
+    def __call__(self):
+        from yade_dda import O
+        fn = fs = 0.0
+        for i in O.interactions:
+            if i.isReal and self.body in (i.id1, i.id2):
+                fn += i.phys.normalForce.norm()
+                fs += i.phys.shearForce.norm()
+        self.n += 1
+        self.zero += fn == 0.0
+        self.normal += fn / self.weightNormal
+        self.normalMax = max(self.normalMax, fn / self.weightNormal)
+        if self.tanPhi > 0 and fn > 0:
+            self.shear += fs / (self.tanPhi * fn)
+        self.tiltMax = max(self.tiltMax, O.bodies[self.body].state.ori.toAxisAngle()[1])
+
+    def summary(self):
+        n = max(self.n, 1)
+        return dict(meanNormalOverWeight=self.normal / n, maxNormalOverWeight=self.normalMax,
+                    stepsWithoutForce=self.zero / n,
+                    meanShearOverFriction=(self.shear / max(self.n - self.zero, 1)) if self.tanPhi > 0 else None,
+                    maxTiltRad=self.tiltMax)
+
+
+_yadeDiagnosis = {}
+
+
+def yadeIncline(phiDeg, fraction, tEnd, diagnose=False):
     """The incline with YADE's own explicit DEM: Polyhedra bodies, InsertionSortCollider,
     Ig2_Polyhedra_Polyhedra_PolyhedraGeom, Ip2_PolyhedraMat_PolyhedraMat_PolyhedraPhys,
     Law2_PolyhedraGeom_PolyhedraPhys_Volumetric, NewtonIntegrator(damping=0), one thread,
@@ -379,6 +427,10 @@ def yadeIncline(phiDeg, fraction, tEnd):
     x0 = O.bodies[b].state.pos[0]
     steps = int(round(tEnd / O.dt))
     O.dt = tEnd / steps                      # land on tEnd exactly
+    if diagnose:
+        _yadeDiagnosis['active'] = _YadeDiagnosis(b, phiDeg)
+        command = 'import sys; sys.modules[%r]._yadeDiagnosis["active"]()' % __name__   # this module, also as __main__
+        O.engines = O.engines + [wrapper.PyRunner(command=command, iterPeriod=1)]
     start = time.perf_counter()
     O.run(steps, True)
     wall = time.perf_counter() - start
@@ -388,7 +440,8 @@ def yadeIncline(phiDeg, fraction, tEnd):
                 error=abs(s - exact), relativeError=(s - exact) / exact, slide=s, exact=exact,
                 normalDisplacement=O.bodies[b].state.pos[2] - 0.5,
                 rotation=O.bodies[b].state.ori.toAxisAngle()[1],
-                wallSeconds=wall, wallPerSimulatedSecond=wall / tEnd)
+                wallSeconds=wall, wallPerSimulatedSecond=wall / tEnd,
+                diagnosis=_yadeDiagnosis.pop('active').summary() if diagnose else None)
 
 
 # ------------------------------------------------------------------ workers
@@ -434,7 +487,13 @@ def worker(task):
                 points.append(p)
                 print('%-16s YADE fraction %.2f (dt %.3g s) error %.6e m, %.3f s wall per simulated s'
                       % (name, fraction, p['dt'], p['error'], p['wallPerSimulatedSecond']), flush=True)
-        return dict(kind='yade', points=points)
+        diagnosis = {}
+        for name in task['scenes']:        # an untimed run with a per-step record of the contact forces
+            phi = 20.0 if name == 'incline_friction' else 0.0
+            d = yadeIncline(phi, 0.5, task['tEnd'], diagnose=True)
+            diagnosis[name] = dict(fraction=0.5, relativeError=d['relativeError'], **d['diagnosis'])
+            print('%-16s YADE diagnosis %s' % (name, json.dumps(diagnosis[name])), flush=True)
+        return dict(kind='yade', points=points, diagnosis=diagnosis)
     if task['kind'] == 'custom':
         return dict(kind='custom', result=runCustom(task['script'], task['knob'], task['values']))
     return dict(kind='knob', knob=task['knob'],
@@ -519,7 +578,8 @@ def plots(result, outDir):
     for knob, scenes in result['knobs'].items():
         names = list(scenes)
         msc = knob in MSC_KNOBS
-        panels = len(names) + (1 if msc else 0)
+        extra = msc or knob == 'contactPenaltyFactor'
+        panels = len(names) + (1 if extra else 0)
         cols = min(3, panels)
         rows = int(math.ceil(panels / float(cols)))
         fig = Figure(figsize=(4.6 * cols, 3.6 * rows + 0.4))
@@ -572,6 +632,20 @@ def plots(result, outDir):
             ax.set_title('detection work (dotted: DESS sub-unit tests)', fontsize=9)
             ax.legend(fontsize=6)
             ax.tick_params(labelsize=7)
+        if knob == 'contactPenaltyFactor':
+            ax = fig.add_subplot(rows, cols, panels)
+            for j, name in enumerate(names):
+                pts = scenes[name]['points']
+                ax.plot([p['value'] for p in pts], [max(p['maxPenetration'], floor) for p in pts], 'o-',
+                        color='C%d' % j, label=name)
+            ax.set_xscale('log')
+            ax.set_yscale('log')
+            ax.set_xlabel('contactPenaltyFactor', fontsize=8)
+            ax.set_ylabel('deepest contact penetration of any step [m]', fontsize=8)
+            ax.set_title('penetration (what the penalty buys)', fontsize=9)
+            ax.legend(fontsize=7)
+            ax.tick_params(labelsize=7)
+            ax.grid(True, which='both', alpha=0.25)
         unit = {'dt': ' [s]', 'criticalLength': ' [m]'}.get(knob, '')
         fig.suptitle('%s%s: error against wall time (labels: %s value; filled: Pareto-optimal)%s'
                      % (knob, unit, knob, '; error identical for every value' if msc else ''), fontsize=10)
@@ -703,8 +777,9 @@ def main():
         print('--- YADE polyhedra DEM: fractions %s of the P-wave step on %s' % (YADE_FRACTIONS[mode],
                                                                               ', '.join(yadeScenes)), flush=True)
         try:
-            result['yade'] = spawn(dict(kind='yade', scenes=yadeScenes, values=YADE_FRACTIONS[mode], tEnd=tEnd),
-                                   taskDir, args.timeout)['points']
+            yade = spawn(dict(kind='yade', scenes=yadeScenes, values=YADE_FRACTIONS[mode], tEnd=tEnd),
+                         taskDir, args.timeout)
+            result['yade'], result['yadeDiagnosis'] = yade['points'], yade['diagnosis']
         except (RuntimeError, subprocess.TimeoutExpired) as e:
             result['failed']['yade'] = str(e)
             print('FAILED yade', e, flush=True)

@@ -120,7 +120,7 @@ def knobEngine(knob):
     return engine, param
 
 
-def advance(tEnd, budgetFactor=20):
+def advance(tEnd, budgetFactor=1000):
     """Runs the scene until O.time == tEnd [s] exactly, in as few ``O.run(n, True)``
     calls as the step control allows (whole steps of the integrator's dt; a
     last shorter step lands on tEnd). Returns the wall seconds spent in the run
