@@ -18,9 +18,11 @@ from .engines import DDAIntegrator
 from .colliders import MSCCollider, DESSCollider, NBSCollider, AllPairsCollider
 from .compare import compareColliders
 from .saveload import Checkpoint, latestCheckpoint, writeCheckpoint, storeState, restoreState
+from .accuracy import sweep
 from .scene import (stats, sync, block, blockOf, setVelocity, addPointLoad, addFixedPoint,
                     printStats, contacts, Ig2_DDABlock_DDABlock_DDAContact)
 
 __all__ = ['ddaBlock', 'DDAIntegrator', 'MSCCollider', 'DESSCollider', 'NBSCollider', 'AllPairsCollider',
-           'compareColliders', 'Checkpoint', 'latestCheckpoint', 'stats', 'printStats', 'sync', 'block', 'blockOf',
+           'compareColliders', 'Checkpoint', 'latestCheckpoint', 'sweep', 'stats', 'printStats', 'sync', 'block',
+           'blockOf',
            'setVelocity', 'addPointLoad', 'addFixedPoint', 'contacts', 'Ig2_DDABlock_DDABlock_DDAContact', 'O']
