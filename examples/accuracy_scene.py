@@ -6,12 +6,14 @@ Coulomb friction (phi = 30 deg). Closed form: the deceleration is g tan(phi),
 so it stops after s = v0^2 / (2 g tan(phi)) = 0.353 m, at t = 0.35 s; by
 tEnd = 0.6 s it rests there.
 
-Measured (one run, dt = 1e-2 and 1e-3 s): the cube slides only 0.033 m and
-0.0027 m, not 0.353 m. In the first step with friction its speed drops from
-2.0 to 1.2 m/s (the closed form: 1.994 m/s), its front contacts open and it
-hops to a stop; without friction it slides on at exactly 2 m/s. A suspected
-fault of the core's first frictional step of a block that arrives moving
-(reported with issue 5); this scene shows it until it is fixed.
+Before the core's friction rules were fixed, the cube slid only 3 mm: its
+contacts with the floor were new in the first step and started locked, the
+spring held the whole step's slip and tipped the cube, and the tipped solve's
+normal force drove the next solve's friction (speed 2.0 -> 1.2 m/s in one
+step). New contacts whose blocks move apart tangentially now start sliding,
+and sliding contacts iterate until their normal force settles; the same
+physics is a test (tests/py/test_contact_physics.py,
+test_block_launched_along_floor_slides_to_a_stop).
 
 The sweep needs three names (SI units):
     build()   makes the scene; O is already reset. One DDAIntegrator in O.engines

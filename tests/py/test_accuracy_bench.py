@@ -69,12 +69,13 @@ def test_freefall_exact_for_every_dt(quick):
 
 
 @pytest.mark.parametrize('scene', ['incline_friction', 'wedge'])
-def test_error_falls_with_dt(quick, scene):
-    points = sorted(quick['knobs']['dt'][scene]['points'], key=lambda p: -p['value'])   # largest dt first
-    errors = [p['error'] for p in points]
-    for coarse, fine in zip(errors, errors[1:]):
-        assert fine <= coarse, errors
-    assert errors[-1] < 0.5 * errors[0], errors
+def test_frictional_slides_within_two_thousandths_at_every_dt(quick, scene):
+    """Friction on a plane and in a wedge: the slide matches the closed form to 2e-3 of its length
+    at every dt of the sweep (1e-2 s included). Before the core's friction rules were fixed, new
+    contacts started locked and the first steps' tipped solves drove the friction, and the error
+    was first order in dt: 0.4% of the incline's slide and 5% of the wedge's at dt = 1e-2 s."""
+    for p in quick['knobs']['dt'][scene]['points']:
+        assert p['error'] < 2e-3 * abs(p['exact']), (p['value'], p['error'], p['exact'])
 
 
 def test_benchmark_checks_pass(quick):
