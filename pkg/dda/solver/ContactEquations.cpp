@@ -79,19 +79,17 @@ void startTrial(Contact& contact, bool formBonds) {
 	if (!contact.normal.valid) contact.trial.state = ContactState::Open;
 }
 
-bool startSlidingIfMoving(Contact& contact, const Block& blockI, const Block& blockJ, const Vector12& Vi,
+void startSlidingIfMoving(Contact& contact, const Block& blockI, const Block& blockJ, const Vector12& Vi,
                           const Vector12& Vj, double dt) {
 	ContactHistory& trial = contact.trial;
-	if (!contact.isNew || trial.state != ContactState::Locked || trial.bonded) return false;
+	if (!contact.isNew || trial.state != ContactState::Locked || trial.bonded) return;
 	const Vector3 velocity = displacementAt(contact.geometry.pointI - blockI.centroid, Vi) -
 	                         displacementAt(contact.geometry.pointJ - blockJ.centroid, Vj);
 	const Vector3 tangential = tangentProjector(contact.geometry.normal) * velocity;
 	const double speed = tangential.norm();
-	if (!(contact.shearStiffness * speed * dt > contact.frictionTangent * std::max(0.0, trial.normalForce)))
-		return false;
+	if (!(contact.shearStiffness * speed * dt > contact.frictionTangent * std::max(0.0, trial.normalForce))) return;
 	trial.state = ContactState::Sliding;
 	trial.slidingDirection = tangential / speed;
-	return true;
 }
 
 double contactGap(const Contact& contact, const Vector12& Di, const Vector12& Dj) {

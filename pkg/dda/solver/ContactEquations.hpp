@@ -85,8 +85,8 @@ void startTrial(Contact& contact, bool formBonds);
 // that only touches: N = 0). A locked spring on a block arriving with
 // tangential speed holds the whole step's slip (a 1 m cube sliding at 2 m/s
 // lost 40% of its speed in its first step, tipped by the spring, and hopped).
-// Bonded contacts stay locked. Returns whether the state changed.
-bool startSlidingIfMoving(Contact& contact, const Block& blockI, const Block& blockJ, const Vector12& Vi,
+// Bonded contacts stay locked.
+void startSlidingIfMoving(Contact& contact, const Block& blockI, const Block& blockJ, const Vector12& Vi,
                           const Vector12& Vj, double dt);
 
 }  // namespace dda

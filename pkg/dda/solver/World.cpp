@@ -253,16 +253,10 @@ void World::setCollider(std::unique_ptr<Collider> collider) {
 	collider_ = std::move(collider);
 }
 
-const Vector12& World::startRates(int block) const {
+const Vector12& World::ofBlock(const std::vector<Vector12>& perMovingBlock, int block) const {
 	static const Vector12 zero = Vector12::Zero();
 	const int k = movingIndex_[block];
-	return k < 0 ? zero : startVelocities_[k];
-}
-
-const Vector12& World::unknowns(int block) const {
-	static const Vector12 zero = Vector12::Zero();
-	const int k = movingIndex_[block];
-	return k < 0 ? zero : solutions_[k];
+	return k < 0 ? zero : perMovingBlock[k];
 }
 
 void World::detectContacts(const IntegratorSettings& settings, StepStatistics& stats) {
@@ -429,7 +423,7 @@ double World::step(const IntegratorSettings& settings) {
 			startTrial(contact, steps_ == 0);
 			contact.frictionSwitches = 0;
 			const int bi = contact.key.blockI, bj = contact.key.blockJ;
-			startSlidingIfMoving(contact, blocks_[bi], blocks_[bj], startRates(bi), startRates(bj), dt);
+			startSlidingIfMoving(contact, blocks_[bi], blocks_[bj], ofBlock(startVelocities_, bi), ofBlock(startVelocities_, bj), dt);
 		}
 		bool converged = false, structureStale = true;
 		int iterations = 0, changes = 0;
@@ -451,7 +445,7 @@ double World::step(const IntegratorSettings& settings) {
 				const ContactHistory before = contact.trial;
 				if (contact.trial.state != ContactState::Open)
 					largestNormalForce = std::max(largestNormalForce, std::abs(contact.trial.normalForce));
-				if (!updateContactState(contact, blocks_[bi], blocks_[bj], unknowns(bi), unknowns(bj), openTolerance)) {
+				if (!updateContactState(contact, blocks_[bi], blocks_[bj], ofBlock(solutions_, bi), ofBlock(solutions_, bj), openTolerance)) {
 					if (contact.trial.state == ContactState::Sliding && contact.frictionTangent > 0)
 						normalForceChange = std::max(normalForceChange,
 						                             std::abs(contact.trial.normalForce - before.normalForce));
@@ -544,7 +538,7 @@ double World::step(const IntegratorSettings& settings) {
 	for (int k = 0; k < n; ++k) motions_[k] = blockMotion(blocks_[moving_[k]], solutions_[k]);
 	for (Contact& contact : contacts) {
 		const int bi = contact.key.blockI, bj = contact.key.blockJ;
-		finishContact(contact, blocks_[bi], blocks_[bj], unknowns(bi), unknowns(bj));
+		finishContact(contact, blocks_[bi], blocks_[bj], ofBlock(solutions_, bi), ofBlock(solutions_, bj));
 		ContactHistory& trial = contact.trial;
 		contact.point = movingIndex_[bi] >= 0 ? motions_[movingIndex_[bi]](contact.geometry.pointI) : contact.geometry.pointI;
 		if (trial.state == ContactState::Locked) {
@@ -555,7 +549,7 @@ double World::step(const IntegratorSettings& settings) {
 			++stats.closedContacts;
 			stats.slidingContacts += trial.state == ContactState::Sliding;
 			stats.maxPenetration =
-			    std::max(stats.maxPenetration, -contactGap(contact, unknowns(bi), unknowns(bj)));
+			    std::max(stats.maxPenetration, -contactGap(contact, ofBlock(solutions_, bi), ofBlock(solutions_, bj)));
 		}
 		contact.history = trial;
 	}

@@ -65,8 +65,9 @@ private:
 	void buildSystemStructure(int movingBlocks, StepStatistics& stats);
 	// Adds the trial-state terms of every contact to coupled_.
 	void assembleContacts();
-	const Vector12& unknowns(int block) const;
-	const Vector12& startRates(int block) const;  // rates at the start of the step, zero for fixed blocks
+	// A block's entry of a per-moving-block array (solutions_, startVelocities_);
+	// zero for fixed blocks.
+	const Vector12& ofBlock(const std::vector<Vector12>& perMovingBlock, int block) const;
 	std::unique_ptr<Collider> collider_ = std::make_unique<DESSCollider>();
 	ContactStore store_;
 	CoupledSystem coupled_;
