@@ -59,6 +59,8 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
+sys.path.insert(0, HERE)
+import benchtasks  # noqa: E402  (bench/benchtasks.py: the child-process protocol)
 G = 9.81
 ROCK = dict(young=1e10, poisson=0.25, density=2600.0)
 
@@ -516,19 +518,11 @@ def runCustom(script, knob, values):
 def spawn(task, taskDir, timeout):
     """Runs one task in its own process (OMP_NUM_THREADS=1); returns its result or raises."""
     name = task['kind'] + '_' + task.get('knob', 'yade')
-    taskFile = os.path.join(taskDir, name + '.task.json')
     task['result'] = os.path.join(taskDir, name + '.result.json')
-    with open(taskFile, 'w') as f:
-        json.dump(task, f)
-    env = dict(os.environ, OMP_NUM_THREADS='1')
-    proc = subprocess.run([sys.executable, os.path.abspath(__file__), '--worker', taskFile], env=env,
-                          stdout=None, stderr=subprocess.PIPE, text=True, timeout=timeout)
-    if proc.returncode != 0 or not os.path.exists(task['result']):
+    proc, result = benchtasks.runWorker(__file__, task, os.path.join(taskDir, name + '.task.json'), timeout,
+                                        captureStdout=False)
+    if result is None:
         raise RuntimeError('%s failed (exit %d): %s' % (name, proc.returncode, proc.stderr.strip()[-3000:]))
-    with open(task['result']) as f:
-        result = json.load(f)
-    os.remove(task['result'])
-    os.remove(taskFile)
     return result
 
 
@@ -676,7 +670,6 @@ def table(result):
 
 
 def machine():
-    sys.path.insert(0, HERE)
     import colliders        # bench/colliders.py: the same machine record
     info = colliders.machine()
     try:
@@ -712,11 +705,7 @@ def main():
     parser.add_argument('--worker', default=None, help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.worker:
-        with open(args.worker) as f:
-            task = json.load(f)
-        result = worker(task)
-        with open(task['result'], 'w') as f:
-            json.dump(result, f)
+        benchtasks.serveWorker(args.worker, worker)
         return
 
     outDir = os.path.dirname(os.path.abspath(args.out))

@@ -36,6 +36,8 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
+sys.path.insert(0, HERE)
+import benchtasks  # noqa: E402  (bench/benchtasks.py: the child-process protocol)
 PAPER = ('hexahedra_drop', 'slanted_slide', 'single_block_slide')
 OURS = ('MSC', 'DESS', 'NBS', 'AllPairs')
 YADE_COLLIDERS = ('InsertionSortCollider', 'SpatialQuickSortCollider')
@@ -646,11 +648,7 @@ def main():
     parser.add_argument('--worker', default=None, help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.worker:
-        with open(args.worker) as f:
-            task = json.load(f)
-        record = worker(task)
-        with open(task['result'], 'w') as f:
-            json.dump(record, f)
+        benchtasks.serveWorker(args.worker, worker)
         return
 
     outDir = os.path.dirname(os.path.abspath(args.out))
@@ -678,7 +676,6 @@ def main():
         print('  ', json.dumps({k: v for k, v in result['sceneInfo']['slender_%d' % n].items()
                                 if k in ('footprint', 'height', 'onGround', 'boxOverlapPairs', 'generationSeconds')}),
               flush=True)
-    env = dict(os.environ, OMP_NUM_THREADS='1')
     taskDir = os.path.join(outDir, 'colliders_runs')
     os.makedirs(taskDir, exist_ok=True)
     for scene in scenes:
@@ -695,25 +692,17 @@ def main():
                         verletDist=args.verlet_dist, quietYade=not args.yade_warnings,
                         result=os.path.join(taskDir, '%s_%s.json' % (scene, safe)))
             taskFile = os.path.join(taskDir, '%s_%s.task.json' % (scene, safe))
-            with open(taskFile, 'w') as f:
-                json.dump(task, f)
             t0 = time.time()
             print('%-20s %-26s %3d steps ... ' % (scene, strategy, steps), end='', flush=True)
             try:
-                proc = subprocess.run([sys.executable, os.path.abspath(__file__), '--worker', taskFile], env=env,
-                                      capture_output=True, text=True, timeout=args.timeout)
-                ok = proc.returncode == 0 and os.path.exists(task['result'])
-                why = None if ok else 'exit %d: %s' % (proc.returncode, proc.stderr.strip()[-2000:])
+                proc, record = benchtasks.runWorker(__file__, task, taskFile, args.timeout, captureStdout=True)
+                why = None if record is not None else 'exit %d: %s' % (proc.returncode, proc.stderr.strip()[-2000:])
             except subprocess.TimeoutExpired:
-                ok, why = False, 'timed out after %.0f s' % args.timeout
-            if not ok:
+                record, why = None, 'timed out after %.0f s' % args.timeout
+            if record is None:
                 result['failed']['%s/%s' % (scene, strategy)] = why
                 print('FAILED (%s)' % why.splitlines()[-1] if why else 'FAILED', flush=True)
                 continue
-            with open(task['result']) as f:
-                record = json.load(f)
-            os.remove(task['result'])
-            os.remove(taskFile)
             record['processSeconds'] = time.time() - t0
             warnings = [line for line in proc.stderr.splitlines() if 'WARN' in line or 'ERROR' in line]
             if warnings:        # e.g. YADE's per-pair do_intersect notice (with --yade-warnings)
