@@ -8,7 +8,7 @@ DEB_PACKAGES := yade cmake g++ make libeigen3-dev libcgal-dev libgmp-dev libmpfr
                 libgtest-dev
 SITE_DIR := $(shell $(PYTHON) -c "import sysconfig;print(sysconfig.get_path('purelib','posix_local'))" 2>/dev/null)
 
-.PHONY: deps build install demo test test-hard test-cpp test-py bench regress regress-quick regress-run clean
+.PHONY: deps build install demo test test-hard test-cpp test-py bench regress regress-quick regress-run fuzz clean
 
 deps:
 	@missing=$$(for p in $(DEB_PACKAGES); do dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null | grep -q 'install ok installed' || echo $$p; done); \
@@ -68,5 +68,19 @@ regress-run:
 	    --log "$$out/@.log" $(TABLE).table 2>&1) | tee $$out/yade-batch.log | grep --line-buffered -E '^#[0-9]+ \('; true
 	$(PYTHON) examples/regression/check.py examples/regression/$(TABLE).table $(abspath $(REGRESS_OUT))/$(TABLE) $(CHECK_ARGS)
 
+# Longer fuzzing of the geometry and contact kernels (README, "Bad input"): tests/fuzz's target built
+# with AddressSanitizer and UBSan in its own build tree, fed by the plain driver for FUZZ_SECONDS with
+# a seed from the clock (printed; findings are written to $(FUZZ_BUILD)/crashes). ctest runs the same
+# target for 20 s without sanitizers.
+FUZZ_SECONDS ?= 600
+FUZZ_BUILD   := build-fuzz
+fuzz: deps
+	cmake -S . -B $(FUZZ_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPYTHON_EXECUTABLE=$(PYTHON) -DPython3_EXECUTABLE=$(PYTHON) \
+	    -DCMAKE_CXX_FLAGS="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer"
+	cmake --build $(FUZZ_BUILD) -j $(JOBS) --target fuzz_kernels_driver
+	mkdir -p $(FUZZ_BUILD)/crashes
+	ASAN_OPTIONS=detect_leaks=0 $(FUZZ_BUILD)/fuzz_kernels_driver --seconds $(FUZZ_SECONDS) --seed $$(date +%s) \
+	    --crash-dir $(FUZZ_BUILD)/crashes tests/fuzz/corpus
+
 clean:
-	rm -rf $(BUILD)
+	rm -rf $(BUILD) $(FUZZ_BUILD)

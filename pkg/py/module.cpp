@@ -8,6 +8,7 @@
 // IndexError, anything else -> RuntimeError.
 #include "SceneLink.hpp"
 #include "dda/collider/MSCCollider.hpp"
+#include "dda/solver/InitialOverlaps.hpp"
 
 #include <boost/python.hpp>
 
@@ -191,6 +192,29 @@ py::object detectPair(const SceneLink& s, int a, int b, double d0) {
 	return py::make_tuple(contactTypeName(result->type), result->normal, result->separation, subs);
 }
 
+// Blocks overlapping when they enter the scene (dda/solver/InitialOverlaps.hpp):
+// the scene's blocks from index firstUnchecked on and `added`, a list of
+// (points, density, young, poisson, fixed) not yet in the scene, numbered
+// blockCount + k. Returns [(a, b, depth [m], tolerance [m]), ...], deepest first.
+py::list initialOverlaps(SceneLink& s, int firstUnchecked, const py::object& added, const IntegratorSettings& settings) {
+	std::vector<Block> extra;
+	for (long k = 0, n = py::len(added); k < n; ++k) {
+		const py::object spec = added[k];
+		Material material;
+		material.density = py::extract<double>(spec[1])();
+		material.young = py::extract<double>(spec[2])();
+		material.poisson = py::extract<double>(spec[3])();
+		extra.push_back(makeBlock(toPoints(spec[0], "block vertices"), material, py::extract<bool>(spec[4])()));
+	}
+	std::vector<const Block*> blocks;
+	for (int i = 0; i < s.world.blockCount(); ++i) blocks.push_back(&s.world.block(i));
+	for (const Block& b : extra) blocks.push_back(&b);
+	py::list out;
+	for (const InitialOverlap& o : findInitialOverlaps(blocks, std::max(0, firstUnchecked), settings))
+		out.append(py::make_tuple(o.blockA, o.blockB, o.depth, o.tolerance));
+	return out;
+}
+
 void setCollider(SceneLink& s, const std::string& name) {
 	if (name == "DESS")
 		s.world.setCollider(std::make_unique<DESSCollider>());
@@ -283,6 +307,8 @@ BOOST_PYTHON_MODULE(_core) {
 	         py::arg("cohesion") = 0.0, py::arg("tensileStrength") = 0.0),
 	        "Raises ValueError naming the problem if the points and material cannot make a DDA block.");
 
+	py::scope().attr("mscMaxSegments") = MSCCollider::kMaxSegments;
+
 	py::class_<IntegratorSettings>("IntegratorSettings", "Parameters of one DDA step (see DDAIntegrator for units and meaning).")
 	    .def_readwrite("maxTimeStep", &IntegratorSettings::maxTimeStep)
 	    .def_readwrite("gravity", &IntegratorSettings::gravity)
@@ -312,6 +338,7 @@ BOOST_PYTHON_MODULE(_core) {
 	    .def("setCollider", &setCollider)
 	    .def("setCover", &setCover)
 	    .def("detectPair", &detectPair)
+	    .def("initialOverlaps", &initialOverlaps)
 	    .def("collider", &colliderName)
 	    .def("linkBody", &linkBody)
 	    .def("blockOfBody", &bodyToBlock)

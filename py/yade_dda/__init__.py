@@ -13,6 +13,7 @@ All quantities are SI: metres, seconds, kilograms, pascals, newtons, radians.
 """
 from . import _yade
 from ._yade import O
+from . import guards  # noqa: F401  (O.bodies.erase/clear guards for DDA blocks)
 from .blocks import ddaBlock
 from .engines import DDAIntegrator
 from .colliders import MSCCollider, DESSCollider, NBSCollider, AllPairsCollider

@@ -20,7 +20,7 @@ class BlockSpec:
 def _vector(value, what, length=3):
     try:
         values = [float(x) for x in value]
-    except TypeError:
+    except (TypeError, ValueError):
         raise TypeError('%s must be a sequence of %d numbers, got %r' % (what, length, value)) from None
     if len(values) != length:
         raise ValueError('%s must have %d components, got %d' % (what, length, len(values)))
@@ -49,7 +49,7 @@ def _points(vertices):
     for i, p in enumerate(items):
         try:
             coords = [float(x) for x in p]
-        except TypeError:
+        except (TypeError, ValueError):
             raise TypeError('point %d must be a sequence of 3 numbers, got %r' % (i, p)) from None
         if len(coords) != 3:
             raise ValueError('point %d must have 3 coordinates, got %d' % (i, len(coords)))
@@ -61,6 +61,8 @@ def _material(material):
     """Resolves YADE's ways of naming a material: None (default), id, label or instance."""
     if material is None:
         return wrapper.PolyhedraMat()
+    if isinstance(material, bool):
+        raise TypeError('material must be a YADE Material, its id or its label, got %r' % (material,))
     if isinstance(material, int):
         if not 0 <= material < len(O.materials) and not -len(O.materials) <= material < 0:
             raise IndexError('no material with id %d (O.materials has %d)' % (material, len(O.materials)))
@@ -141,24 +143,43 @@ def ddaBlock(vertices, material=None, fixed=False, color=None, velocity=(0, 0, 0
     angularVelocity = _vector(angularVelocity, 'angularVelocity')
     if fixed and (any(velocity) or any(angularVelocity)):
         raise ValueError('a fixed block cannot have an initial velocity')
+    try:
+        fixedPoints, loads = list(fixedPoints), list(loads)
+    except TypeError:
+        raise TypeError('fixedPoints and loads must be sequences, got %r and %r' % (fixedPoints, loads)) from None
+    if fixed and (fixedPoints or loads):
+        raise ValueError('a fixed block cannot have fixed points or point loads (they would have no effect)')
     fixedList = []
     for i, entry in enumerate(fixedPoints):
+        if not hasattr(entry, '__len__'):
+            raise TypeError('fixed point %d must be a point or (point, stiffness), got %r' % (i, entry))
         if len(entry) == 2 and not isinstance(entry[0], (int, float)):
             point, stiffness = entry
         else:
             point, stiffness = entry, 0.0
         point = _vector(point, 'fixed point %d' % i)
-        stiffness = float(stiffness)
-        if not (math.isfinite(stiffness) and stiffness >= 0):
-            raise ValueError('fixed point %d: stiffness must be >= 0 N/m, got %r' % (i, stiffness))
+        stiffness = _finiteNonNegative(stiffness, 'fixed point %d stiffness' % i, 'N/m')
         fixedList.append((point, stiffness))
-    loadList = [(_vector(p, 'load %d point' % i), _vector(f, 'load %d force' % i)) for i, (p, f) in enumerate(loads)]
+    loadList = []
+    for i, entry in enumerate(loads):
+        try:
+            point, force = entry
+        except (TypeError, ValueError):
+            raise TypeError('load %d must be a pair (point [m], force [N]), got %r' % (i, entry)) from None
+        loadList.append((_vector(point, 'load %d point' % i), _vector(force, 'load %d force' % i)))
     if stress is not None:
         stress = _vector(stress, 'stress', 6)
-    if not isinstance(mask, int):
+    if not isinstance(mask, int) or isinstance(mask, bool):
         raise TypeError('mask must be an int, got %r' % (mask,))
+    if color is not None:
+        color = _vector(color, 'color')
 
     body = utils.polyhedron(points, fixed=fixed, wire=wire, color=color, material=mat, mask=mask)
+    if len(body.shape.v) != len(points):
+        # YADE's Polyhedra builds its own hull with its own tolerances (absolute ones: a 1e9 m cube lost a corner)
+        raise ValueError('YADE\'s Polyhedra shape of this block has %d corners instead of %d (YADE merged corners '
+                         'its own tolerances cannot tell apart); rescale the block or shift its coordinates'
+                         % (len(body.shape.v), len(points)))
     if not fixed:
         body.state.vel = velocity
         body.state.angVel = angularVelocity

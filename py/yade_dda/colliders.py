@@ -16,6 +16,7 @@ carries every parameter, so an engine that comes back from
 ``O.save()``/``O.load()`` as a plain PyRunner still selects the same strategy.
 """
 from ._yade import O, wrapper
+from . import _core
 from . import engines as _engines
 from . import scene as _scene
 from .engines import _Parameter, _finite, _initEngine
@@ -144,9 +145,11 @@ def _criticalLength(value):
 
 
 def _segments(value):
-    if isinstance(value, bool) or int(value) != value:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or int(value) != value:
         raise ValueError('segments must be an integer >= 1, got %r' % (value,))
-    return int(_finite('segments', value, 1))
+    if not 1 <= value <= _core.mscMaxSegments:
+        raise ValueError('segments must be an integer in [1, %d], got %r' % (_core.mscMaxSegments, value))
+    return int(value)
 
 
 class MSCCollider(_ColliderEngine):

@@ -12,12 +12,18 @@ import time
 
 from ._yade import O, wrapper
 from . import _core
+from . import guards as _guards
 from . import scene as _scene
 from .blocks import _vector
 
 
 def _finite(name, value, low=None, high=None, lowOpen=False, unit=''):
-    value = float(value)
+    if isinstance(value, bool):
+        raise TypeError('%s must be a number, got %r' % (name, value))
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        raise TypeError('%s must be a number, got %r' % (name, value)) from None
     ok = math.isfinite(value)
     if ok and low is not None:
         ok = value > low if lowOpen else value >= low
@@ -51,6 +57,20 @@ class _Parameter:
 _COLLIDERS = ('DESS', 'NBS', 'AllPairs', 'MSC')
 
 
+_INT_MAX = 2 ** 31 - 1   # the core's counters are C ints
+
+
+def _integer(name, low, high=_INT_MAX):
+    """Validator of an integer parameter in [low, high]; rejects 1.5, '3', True."""
+    def check(value):
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or value != int(value):
+            raise TypeError('%s must be an integer, got %r' % (name, value))
+        if not low <= value <= high:
+            raise ValueError('%s must be an integer in [%d, %d], got %r' % (name, low, high, value))
+        return int(value)
+    return check
+
+
 def _colliderName(value):
     if value not in _COLLIDERS:
         raise ValueError('collider must be one of %s, got %r' % (', '.join(_COLLIDERS), value))
@@ -71,6 +91,8 @@ def _initEngine(engine, label, params):
     for name in names:
         descriptor = type(engine).__dict__[name]
         engine._params[name] = descriptor.check(params.get(name, descriptor.default))
+    if not isinstance(label, str):
+        raise TypeError('label must be a string, got %r' % (label,))
     engine.iterPeriod = 1
     engine.initRun = True
     if label:
@@ -154,18 +176,18 @@ class DDAIntegrator(wrapper.PyRunner):
     maxDisplacementRatio = _Parameter(0.01, lambda v: _finite('maxDisplacementRatio', v, 0, 1, lowOpen=True),
                                       'allowed displacement / half scene size [-]')
     timeStepGrowth = _Parameter(1.3, lambda v: _finite('timeStepGrowth', v, 1), 'dt growth after a step [-]')
-    maxStepCuts = _Parameter(30, lambda v: int(_finite('maxStepCuts', v, 0)), 'redos allowed per step')
+    maxStepCuts = _Parameter(30, _integer('maxStepCuts', 0), 'redos allowed per step')
     fixedPointPenaltyFactor = _Parameter(1000.0, lambda v: _finite('fixedPointPenaltyFactor', v, 0, lowOpen=True),
                                          'default fixed-point stiffness / (E x block size) [-]')
-    threads = _Parameter(0, lambda v: int(_finite('threads', v, 0)), 'core threads, 0 = all')
-    syncPeriod = _Parameter(0, lambda v: int(_finite('syncPeriod', v, 0)), 'steps between syncs, 0 = automatic')
+    threads = _Parameter(0, _integer('threads', 0), 'core threads, 0 = all')
+    syncPeriod = _Parameter(0, _integer('syncPeriod', 0), 'steps between syncs, 0 = automatic')
     contactDistance = _Parameter(0.0, lambda v: _finite('contactDistance', v, 0, unit=' m'),
                                  'contact distance d0 [m]; 0 = 2.5 x allowed step displacement')
     contactPenaltyFactor = _Parameter(40.0, lambda v: _finite('contactPenaltyFactor', v, 0, lowOpen=True),
                                       'contact normal stiffness / min(E x block size) [-]')
     shearStiffnessRatio = _Parameter(0.4, lambda v: _finite('shearStiffnessRatio', v, 0),
                                      'contact shear / normal stiffness [-]')
-    maxOpenCloseIterations = _Parameter(20, lambda v: int(_finite('maxOpenCloseIterations', v, 1)),
+    maxOpenCloseIterations = _Parameter(20, _integer('maxOpenCloseIterations', 1),
                                         'open-close iterations before dt is cut')
     openCloseShrink = _Parameter(0.3, lambda v: _finite('openCloseShrink', v, 0, 0.99, lowOpen=True),
                                  'dt factor when the open-close iteration does not converge [-]')
@@ -264,7 +286,11 @@ def _isOwnCommand(engine):
 
 
 def _checkEngines(scene, engines):
-    """Refuses engine lists that would move DDA blocks twice."""
+    """Refuses engine lists that would move DDA blocks twice, or make YADE contacts with them."""
+    _guards.checkSingleIntegrator(engines)
+    from .colliders import _checkOrder   # (colliders imports this module)
+    _checkOrder()   # here too: a collider engine after us would run only after our step
+    _guards.checkYadeContacts(scene, engines)
     for engine in engines:
         if isinstance(engine, wrapper.NewtonIntegrator):
             for bodyId in scene.bodyOfBlock:
@@ -283,10 +309,12 @@ def integratorStep(text):
     params, settings = _parse(text)
     scene = _scene.current()
     before = len(scene.bodyOfBlock)
+    _guards.checkInitialOverlaps(scene, settings)   # before the new blocks enter the core
     scene.resolvePending()
+    _guards.markOverlapsChecked(scene)
     engines = O.engines
     signature = tuple((type(e).__name__, e.mask) if isinstance(e, wrapper.NewtonIntegrator) else type(e).__name__
-                      for e in engines)
+                      for e in engines) + (len(O.bodies),)
     if len(scene.bodyOfBlock) != before or scene.checkedEngines != signature:
         _checkEngines(scene, engines)
         scene.checkedEngines = signature

@@ -64,7 +64,7 @@ class DDAScene:
 
     def blockIndex(self, body):
         """Block index of a body (a Body or an id); raises for non-DDA bodies."""
-        bodyId = body if isinstance(body, int) else body.id
+        bodyId = _bodyId(body)
         self.resolvePending()
         index = self.core.blockOfBody(bodyId)
         if index is None:
@@ -107,6 +107,15 @@ def register(scene):
 def drop(token):
     """Forgets a DDA scene (its YADE scene was replaced by O.load)."""
     _scenes.pop(token, None)
+
+def _bodyId(body):
+    """The id of a Body or of an int id; TypeError for anything else."""
+    if isinstance(body, int) and not isinstance(body, bool):
+        return body
+    bodyId = getattr(body, 'id', None)
+    if not isinstance(bodyId, int):
+        raise TypeError('expected a YADE Body or a body id (int), got %r' % (body,))
+    return bodyId
 
 
 def current(create=True):
@@ -299,7 +308,11 @@ class Ig2_DDABlock_DDABlock_DDAContact:
     def go(self, body1, body2, contactDistance=0.0):
         scene = _require()
         i, j = scene.blockIndex(body1), scene.blockIndex(body2)
-        result = scene.core.detectPair(i, j, float(contactDistance))
+        try:
+            contactDistance = float(contactDistance)
+        except (TypeError, ValueError):
+            raise TypeError('contactDistance must be a number [m], got %r' % (contactDistance,)) from None
+        result = scene.core.detectPair(i, j, contactDistance)
         if result is None:
             return None
         ctype, normal, separation, subs = result
@@ -321,7 +334,7 @@ def blockOf(body):
     scene = current(create=False)
     if scene is None:
         return None
-    bodyId = body if isinstance(body, int) else body.id
+    bodyId = _bodyId(body)
     scene.resolvePending()
     return scene.core.blockOfBody(bodyId)
 
@@ -342,4 +355,7 @@ def addPointLoad(body, point, force):
 def addFixedPoint(body, point, stiffness=0):
     """Holds the material point now at point [m] with a penalty spring [N/m] (0: default)."""
     scene = _require()
+    stiffness = float(stiffness)
+    if not (stiffness >= 0 and stiffness < float('inf')):
+        raise ValueError('fixed point stiffness must be finite and >= 0 N/m (0: default), got %r' % stiffness)
     scene.core.addFixedPoint(scene.blockIndex(body), point, stiffness)

@@ -215,7 +215,13 @@ TrianglePlane trianglePlane(const std::vector<Vector3>& points, const Triangle& 
 	const Vector3& o = points[tri[corner]];
 	const Vector3 n = (points[tri[(corner + 1) % 3]] - o).cross(points[tri[(corner + 2) % 3]] - o);
 	const double doubleArea = n.norm();
-	if (!(doubleArea > 0)) internalError("hull triangle with zero area");
+	// Not collinear (CGAL decided exactly), yet the double cross product is
+	// zero: a sliver of nearly collinear points (found by the fuzzer).
+	if (!(doubleArea > 0)) {
+		throw InputError("points " + std::to_string(tri[0]) + ", " + std::to_string(tri[1]) + " and " +
+		                 std::to_string(tri[2]) + " form a hull triangle so thin that its normal is lost to round-off "
+		                 "(they are collinear to double precision): the block is degenerate there");
+	}
 	return {{n / doubleArea, (points[tri[0]] + points[tri[1]] + points[tri[2]]) / 3.0}, doubleArea};
 }
 
@@ -386,6 +392,21 @@ std::vector<std::vector<int>> facetBoundaries(const std::vector<Triangle>& trian
 
 // ---------------------------------------------------------------- step 5
 
+// The block is too small for its distance from the origin: the round-off of
+// its coordinates (an ulp of the largest, relative to the block's size)
+// exceeds the face tolerance, so its faces cannot be resolved.
+InputError roundoffError(const std::vector<Vector3>& points, std::size_t i) {
+	double largest = 0;
+	for (const Vector3& p : points) largest = std::max(largest, p.cwiseAbs().maxCoeff());
+	const double diagonal = boundingBoxDiagonal(points);
+	return InputError("point " + std::to_string(i) + " " + formatPoint(points[i]) +
+	                  " lies outside the hull of the block's own faces by more than " + toleranceText() +
+	                  ": the block (bounding-box diagonal " + formatNumber(diagonal) + ") is too small for its distance " +
+	                  "from the origin (coordinates up to " + formatNumber(largest) + ", " +
+	                  formatNumber(largest / diagonal) + " block sizes), where double precision cannot resolve its "
+	                  "faces; move the origin of the coordinates closer to the block");
+}
+
 // Every input point must be a corner of the merged faces: on the boundary of at
 // least 3 of them. Otherwise the faces whose plane it lies on (exactly or
 // within the tolerance, the same test as the merge) tell where it is: none,
@@ -403,7 +424,10 @@ void requireAllCorners(const std::vector<Vector3>& points, const Facets& facets,
 
 	for (std::size_t i = 0; i < points.size(); ++i) {
 		for (int f = 0; f < facetCount; ++f) {
-			if (facets.planeOf[f].signedDistance(points[i]) > tolerance) internalError("input point outside its own hull");
+			// A hull point outside a hull facet's plane: only round-off of the
+			// plane (a tiny block far from the origin, where the coordinates'
+			// ulps exceed the tolerance) puts it there. Found by the fuzzer.
+			if (facets.planeOf[f].signedDistance(points[i]) > tolerance) throw roundoffError(points, i);
 		}
 		if (cyclesAt[i].size() >= static_cast<std::size_t>(kMinFacetsAtCorner)) continue;
 

@@ -1,6 +1,8 @@
 #include "BlockEquations.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 
 namespace dda {
 
@@ -35,9 +37,18 @@ Vector12 solveBlock(const Block& block, const BlockSystem& system) {
 }
 
 double largestVertexDisplacement(const Block& block, const Vector12& D) {
+	// A non-finite solution is an unbounded displacement: +inf, never NaN,
+	// which std::max and OpenMP's max reduction would silently drop (a NaN
+	// solution then passed the step's finiteness check as 0 and wrote NaN
+	// into every block; found with dt = 1e-300 s).
+	constexpr double unbounded = std::numeric_limits<double>::infinity();
+	if (!D.allFinite()) return unbounded;
 	double largest = 0;
-	for (const Vector3& x : block.vertices)
-		largest = std::max(largest, displacementAt(x - block.centroid, D).squaredNorm());
+	for (const Vector3& x : block.vertices) {
+		const double d = displacementAt(x - block.centroid, D).squaredNorm();
+		if (std::isnan(d)) return unbounded;
+		largest = std::max(largest, d);
+	}
 	return std::sqrt(largest);
 }
 

@@ -37,7 +37,8 @@ void assembleBlock(const Block& block, const IntegratorSettings& settings, doubl
 // 9x9 system; otherwise the full 12x12 one. Both by Cholesky (K is SPD).
 Vector12 solveBlock(const Block& block, const BlockSystem& system);
 
-// Largest displacement of a vertex for the unknowns D [m].
+// Largest displacement of a vertex for the unknowns D [m]; +inf when D or a
+// displacement is not finite.
 double largestVertexDisplacement(const Block& block, const Vector12& D);
 
 // The map of one block's points over a step: x -> c' + (I + S) R (x - c), an

@@ -143,6 +143,11 @@ double projectedHullArea(const std::vector<Vector3>& points, const Vector3& norm
 }  // namespace
 
 int World::addBlock(const std::vector<Vector3>& points, const Material& material, bool fixed) {
+	blocks_.push_back(makeBlock(points, material, fixed));
+	return blockCount() - 1;
+}
+
+Block makeBlock(const std::vector<Vector3>& points, const Material& material, bool fixed) {
 	validateMaterial(material);
 	auto shape = std::make_shared<const ConvexPolyhedron>(buildConvexPolyhedron(points));
 	const MassProperties properties = computeMassProperties(shape->vertices, shape->faces);
@@ -157,8 +162,7 @@ int World::addBlock(const std::vector<Vector3>& points, const Material& material
 	block.material = material;
 	block.elasticity = elasticityMatrix(material.young, material.poisson);
 	block.fixed = fixed;
-	blocks_.push_back(std::move(block));
-	return blockCount() - 1;
+	return block;
 }
 
 Block& World::block(int index) {
@@ -174,13 +178,17 @@ const Block& World::block(int index) const { return const_cast<World*>(this)->bl
 void World::addFixedPoint(int index, const Vector3& position, double stiffness) {
 	requireFinite(position, "a fixed point");
 	if (!std::isfinite(stiffness)) throw InputError("fixed point stiffness must be finite");
-	block(index).fixedPoints.push_back({position, position, stiffness});
+	Block& b = block(index);
+	if (b.fixed) throw InputError("block " + std::to_string(index) + " is fixed: a fixed point would have no effect");
+	b.fixedPoints.push_back({position, position, stiffness});
 }
 
 void World::addPointLoad(int index, const Vector3& position, const Vector3& force) {
 	requireFinite(position, "a point load's position");
 	requireFinite(force, "a point load's force");
-	block(index).loads.push_back({position, force});
+	Block& b = block(index);
+	if (b.fixed) throw InputError("block " + std::to_string(index) + " is fixed: a point load would have no effect");
+	b.loads.push_back({position, force});
 }
 
 void World::setVelocity(int index, const Vector3& velocity, const Vector3& angularVelocity) {

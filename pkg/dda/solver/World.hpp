@@ -18,6 +18,10 @@ namespace dda {
 class StateWriter;
 class StateReader;
 
+// A block at rest built from its corners [m] and material, not in any world
+// (throws InputError naming the problem). World::addBlock adds one.
+Block makeBlock(const std::vector<Vector3>& points, const Material& material, bool fixed);
+
 class World {
 public:
 	// Builds and validates a block (throws InputError; the world is unchanged then).
