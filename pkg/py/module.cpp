@@ -48,9 +48,9 @@ py::list toList(const std::vector<Vector3>& points) {
 }
 
 int addBlock(SceneLink& scene, const py::object& points, double density, double young, double poisson,
-             double frictionAngle, double cohesion, double tensileStrength, bool fixed) {
+             double frictionAngle, double cohesion, double tensileStrength, bool fixed, bool rigid) {
 	return scene.world.addBlock(toPoints(points, "block vertices"),
-	                            Material{density, young, poisson, frictionAngle, cohesion, tensileStrength}, fixed);
+	                            Material{density, young, poisson, frictionAngle, cohesion, tensileStrength}, fixed, rigid);
 }
 
 // Validates a block without adding it (ddaBlock calls this before making a body).
@@ -102,6 +102,7 @@ py::tuple blockStress(const SceneLink& s, int i) { return toTuple(s.world.block(
 py::tuple blockStrain(const SceneLink& s, int i) { return toTuple(s.world.block(i).strain); }
 Eigen::Quaterniond blockRotation(const SceneLink& s, int i) { return s.world.block(i).rotation; }
 bool blockFixed(const SceneLink& s, int i) { return s.world.block(i).fixed; }
+bool blockRigid(const SceneLink& s, int i) { return s.world.block(i).rigid; }
 py::list blockFixedPoints(const SceneLink& s, int i) {
 	py::list out;
 	for (const FixedPoint& p : s.world.block(i).fixedPoints) out.append(p.position);
@@ -248,6 +249,9 @@ py::dict lastStep(const SceneLink& s) {
 	d["blocks"] = st.blocks;
 	d["movingBlocks"] = st.movingBlocks;
 	d["unknowns"] = st.unknowns;
+	d["rigidBlocks"] = st.rigidBlocks;
+	d["strainUnknowns"] = st.strainUnknowns;
+	d["solvedUnknowns"] = st.solvedUnknowns;
 	d["contactDistance"] = st.contactDistance;
 	d["candidatePairs"] = st.candidatePairs;
 	d["shellPairs"] = st.shellPairs;
@@ -333,7 +337,7 @@ BOOST_PYTHON_MODULE(_core) {
 	py::class_<SceneLink, boost::noncopyable>("Scene", "The DDA state of one YADE scene; the core is the source of truth.")
 	    .def("addBlock", &addBlock,
 	         (py::arg("points"), py::arg("density"), py::arg("young"), py::arg("poisson"), py::arg("frictionAngle"),
-	          py::arg("cohesion"), py::arg("tensileStrength"), py::arg("fixed")))
+	          py::arg("cohesion"), py::arg("tensileStrength"), py::arg("fixed"), py::arg("rigid") = false))
 	    .def("contacts", &contactList)
 	    .def("setCollider", &setCollider)
 	    .def("setCover", &setCover)
@@ -355,6 +359,7 @@ BOOST_PYTHON_MODULE(_core) {
 	    .def("strain", &blockStrain)
 	    .def("rotation", &blockRotation)
 	    .def("isFixed", &blockFixed)
+	    .def("isRigid", &blockRigid)
 	    .def("fixedPoints", &blockFixedPoints)
 	    .def("addFixedPoint", &addFixedPoint)
 	    .def("addPointLoad", &addPointLoad)

@@ -14,7 +14,7 @@ All quantities are SI: metres, seconds, kilograms, pascals, newtons, radians.
 from . import _yade
 from ._yade import O
 from . import guards  # noqa: F401  (O.bodies.erase/clear guards for DDA blocks)
-from .blocks import ddaBlock
+from .blocks import ddaBlock, rigidBlock
 from .engines import DDAIntegrator
 from .colliders import MSCCollider, DESSCollider, NBSCollider, AllPairsCollider
 from .compare import compareColliders
@@ -23,7 +23,7 @@ from .accuracy import sweep
 from .scene import (stats, sync, block, blockOf, setVelocity, addPointLoad, addFixedPoint,
                     printStats, contacts, Ig2_DDABlock_DDABlock_DDAContact)
 
-__all__ = ['ddaBlock', 'DDAIntegrator', 'MSCCollider', 'DESSCollider', 'NBSCollider', 'AllPairsCollider',
+__all__ = ['ddaBlock', 'rigidBlock', 'DDAIntegrator', 'MSCCollider', 'DESSCollider', 'NBSCollider', 'AllPairsCollider',
            'compareColliders', 'Checkpoint', 'latestCheckpoint', 'sweep', 'stats', 'printStats', 'sync', 'block',
            'blockOf',
            'setVelocity', 'addPointLoad', 'addFixedPoint', 'contacts', 'Ig2_DDABlock_DDABlock_DDAContact', 'O']

@@ -10,7 +10,7 @@ class BlockSpec:
     """What the core needs to build a block once its body is in O.bodies."""
 
     __slots__ = ('points', 'density', 'young', 'poisson', 'frictionAngle', 'cohesion', 'tensileStrength', 'fixed',
-                 'fixedPoints', 'loads', 'stress')
+                 'rigid', 'fixedPoints', 'loads', 'stress')
 
     def __init__(self, **kw):
         for key in self.__slots__:
@@ -91,7 +91,7 @@ def _elasticConstants(material):
 
 def ddaBlock(vertices, material=None, fixed=False, color=None, velocity=(0, 0, 0),
              angularVelocity=(0, 0, 0), fixedPoints=(), loads=(), stress=None, mask=1, wire=False,
-             cohesion=0.0, tensileStrength=0.0):
+             cohesion=0.0, tensileStrength=0.0, rigid=False):
     """A DDA block as a YADE Body, ready for ``O.bodies.append``.
 
     The block is the convex polyhedron whose corners are ``vertices`` [m]
@@ -109,6 +109,14 @@ def ddaBlock(vertices, material=None, fixed=False, color=None, velocity=(0, 0, 0
         YADE's default ``frictionAngle`` is 0.5 rad; set 0 for frictionless
         joints.
     :param fixed: a fixed block never moves and has no unknowns.
+    :param rigid: a rigid block (a bool) has 6 unknowns, the translation [m]
+        and rotation [rad] of its centroid, instead of 12: no strain, no
+        stress, no elastic term, and the solver factorises 6 rows for it
+        instead of 12. Its material's ``young`` [Pa] still sets the stiffness
+        of its contacts (``contactPenaltyFactor x`` the smaller ``E x size``
+        of the two blocks). A rigid block cannot take ``stress``. Use it for
+        blocks whose strain ``stress/E`` is negligible against the motion of
+        interest. For every block of a material, see ``rigidBlock``.
     :param velocity: initial velocity of the centroid [m/s].
     :param angularVelocity: initial angular velocity [rad/s].
     :param fixedPoints: material points [m] held by penalty springs; each entry
@@ -126,13 +134,17 @@ def ddaBlock(vertices, material=None, fixed=False, color=None, velocity=(0, 0, 0
 
     Raises ValueError naming the problem for bad geometry (fewer than 4 points,
     coplanar, duplicated, NaN/inf, a point that is not a corner of the hull),
-    bad material constants, or non-finite vectors; nothing is added then.
+    bad material constants, non-finite vectors, or an initial stress on a
+    rigid block; TypeError for a ``rigid`` that is not a bool; nothing is
+    added then.
 
     Example::
 
         b = O.bodies.append(ddaBlock([(0,0,0),(1,0,0),(0,1,0),(1,1,0),(0,0,1),(1,0,1),(0,1,1),(1,1,1)],
                                      material=mat, velocity=(1, 0, 0)))
     """
+    if not isinstance(rigid, bool):
+        raise TypeError('rigid must be True or False, got %r' % (rigid,))
     points = _points(vertices)
     mat = _material(material)
     density, young, poisson, frictionAngle = _elasticConstants(mat)
@@ -169,6 +181,9 @@ def ddaBlock(vertices, material=None, fixed=False, color=None, velocity=(0, 0, 0
         loadList.append((_vector(point, 'load %d point' % i), _vector(force, 'load %d force' % i)))
     if stress is not None:
         stress = _vector(stress, 'stress', 6)
+        if rigid and any(stress):
+            raise ValueError('a rigid block has no strain and carries no stress; got stress=%r [Pa] with rigid=True '
+                             '(make the block deformable, or drop the stress)' % (stress,))
     if not isinstance(mask, int) or isinstance(mask, bool):
         raise TypeError('mask must be an int, got %r' % (mask,))
     if color is not None:
@@ -184,7 +199,23 @@ def ddaBlock(vertices, material=None, fixed=False, color=None, velocity=(0, 0, 0
         body.state.vel = velocity
         body.state.angVel = angularVelocity
     spec = BlockSpec(points=points, density=density, young=young, poisson=poisson, frictionAngle=frictionAngle,
-                     cohesion=cohesion, tensileStrength=tensileStrength, fixed=bool(fixed),
+                     cohesion=cohesion, tensileStrength=tensileStrength, fixed=bool(fixed), rigid=rigid,
                      fixedPoints=fixedList, loads=loadList, stress=stress)
     _scene.current().register(body, spec)
     return body
+
+
+def rigidBlock(vertices, material=None, **kw):
+    """``ddaBlock(vertices, material, rigid=True, **kw)``: a block with 6 unknowns.
+
+    Rigidity is chosen per block, not by the material: the material's
+    ``young`` [Pa] still sets the stiffness of the block's contacts, so no
+    value of it can mean "does not deform" without also changing the contacts,
+    and YADE does not save extra attributes of a material. To make every block
+    of one material rigid, build them all with this function (or pass
+    ``rigid=True``). Example::
+
+        rock = O.materials.append(PolyhedraMat(young=1e10, poisson=0.25, density=2600))
+        b = O.bodies.append(rigidBlock(corners, material=rock))
+    """
+    return ddaBlock(vertices, material=material, rigid=True, **kw)

@@ -46,7 +46,7 @@ class DDAScene:
                 waiting.append((body, spec))   # made but not (yet) appended: not simulated
                 continue
             index = self.core.addBlock(spec.points, spec.density, spec.young, spec.poisson, spec.frictionAngle,
-                                       spec.cohesion, spec.tensileStrength, spec.fixed)
+                                       spec.cohesion, spec.tensileStrength, spec.fixed, bool(spec.rigid))
             self.core.linkBody(index, body.id, body.state.ori, list(body.shape.v))
             # The body's state is read here, so a script may still set
             # b.state.vel / b.state.angVel between ddaBlock() and the first step.
@@ -161,7 +161,11 @@ def stats():
     Keys: ``dt`` [s] taken, ``stepCuts`` (redos with a smaller dt in that step,
     for either reason below), ``displacementLimitMisses`` (cumulative steps
     accepted above the bound), ``maxDisplacement`` and ``allowedDisplacement``
-    [m], ``blocks``, ``movingBlocks``, ``unknowns`` (system size).
+    [m], ``blocks``, ``movingBlocks``, ``unknowns`` (system size: 12 per
+    moving block, 6 per rigid one), ``rigidBlocks`` (moving rigid blocks),
+    ``strainUnknowns`` (6 per deformable moving block), ``solvedUnknowns``
+    (unknowns the last solve factorised, counted by the solver: equals
+    ``unknowns``).
     Contacts: ``collider`` (the broad phase used: 'MSC', 'DESS', 'NBS' or
     'AllPairs'), ``contactDistance`` [m] (d0 used), ``candidatePairs`` (block pairs
     from the broad phase), ``shells``, ``shellPairs`` (overlapping bounding
@@ -230,6 +234,7 @@ class BlockView:
     strain = property(lambda self: self._core.strain(self.index), doc='accumulated (ex, ey, ez, gxy, gyz, gzx) [-]')
     rotation = property(lambda self: self._core.rotation(self.index), doc='rotation since creation (Quaternion)')
     fixed = property(lambda self: self._core.isFixed(self.index))
+    rigid = property(lambda self: self._core.isRigid(self.index), doc='a rigid block: 6 unknowns, no strain or stress')
     fixedPoints = property(lambda self: self._core.fixedPoints(self.index), doc='current fixed-point positions [m]')
 
 

@@ -918,3 +918,59 @@ TEST(ContactDetection, OverlapOfTurnedLogsIsRepresentedByASubContact) {
 	for (const SubContact& c : result->contacts) deepest = std::min(deepest, c.gap);
 	EXPECT_LT(deepest, 0.9 * result->separation) << "no sub-contact carries the overlap";
 }
+
+// A cube tilted 0.004 rad and turned 0.3 rad over a fixed unit cube, its
+// lowest corner overhanging the fixed cube's edge x = 1 so that the pair's
+// closest features are two edges crossing (an edge entrance). Its far
+// corners come within d0 = 1e-2 m of the fixed cube's top face. Before, an
+// edge entrance gave the crossing only: those corners were no contact and a
+// cube rocking down onto its neighbour (a pile of turned cubes) sank 1.2 mm
+// into it within a step. Every corner of the tilted cube within d0 of the
+// top face's plane and above the face must now have its vertex-face contact,
+// gap the corner's height above z = 1 (closed form), and the crossing keeps
+// its one edge-edge contact.
+TEST(ContactDetection, EdgeEntranceAlsoGivesTheFarCornersWithinContactDistance) {
+	const Block fixed = box(Vector3(0, 0, 0), Vector3(1, 1, 1));
+	const Block centred = box(Vector3(-0.5, -0.5, -0.5), Vector3(0.5, 0.5, 0.5));
+	const Matrix3 R = rotationAbout(Vector3(1, 1, 0), 0.004) * rotationAbout(Vector3::UnitZ(), 0.3);
+	const Block turned = moved(centred, R, Vector3::Zero());
+	const Vector3 lowest = *std::min_element(turned.vertices.begin(), turned.vertices.end(),
+	                                         [](const Vector3& p, const Vector3& q) { return p.z() < q.z(); });
+	const Block tilted = moved(turned, Matrix3::Identity(), Vector3(1.05, 0.3, 1.0) - lowest);
+	const DetectionSettings s = settings(1e-2);
+	const auto r = detect(fixed, tilted, s);
+	ASSERT_TRUE(r.has_value());
+	SCOPED_TRACE(describe(*r));
+	EXPECT_EQ(r->entrance.kind, EntranceFeature::EdgePair);
+	checkInvariants(*r, fixed, tilted, s);
+	const int topFace = [&] {
+		for (int f = 0; f < static_cast<int>(fixed.shape.faces.size()); ++f) {
+			bool top = true;
+			for (int v : fixed.shape.faces[f]) top = top && fixed.vertices[v].z() == 1.0;
+			if (top) return f;
+		}
+		return -1;
+	}();
+	ASSERT_GE(topFace, 0);
+	int expected = 0;
+	for (int v = 0; v < static_cast<int>(tilted.vertices.size()); ++v) {
+		const Vector3& p = tilted.vertices[v];
+		if (p.z() - 1 > s.contactDistance || p.x() < 0 || p.x() > 1 || p.y() < 0 || p.y() > 1) continue;
+		++expected;
+		const auto found = std::find_if(r->contacts.begin(), r->contacts.end(), [&](const SubContact& c) {
+			return c.kind == ContactKind::VertexFace && !c.firstIsA && c.feature1 == v && c.feature2 == topFace;
+		});
+		ASSERT_NE(found, r->contacts.end()) << "corner " << v << " at height " << p.z() - 1 << " has no contact";
+		EXPECT_NEAR(found->gap, p.z() - 1, kRoundoff);
+	}
+	EXPECT_GE(expected, 1) << "the scene must have a far corner within d0";
+	const auto& entrance = r->entrance;
+	EXPECT_EQ(std::count_if(r->contacts.begin(), r->contacts.end(),
+	                        [&](const SubContact& c) {
+		                        return c.kind == ContactKind::EdgeEdge &&
+		                               (c.firstIsA ? c.feature1 == entrance.feature && c.feature2 == entrance.other
+		                                           : c.feature1 == entrance.other && c.feature2 == entrance.feature);
+	                        }),
+	          1);
+	EXPECT_EQ(r->type, ContactType::FaceFace);
+}

@@ -18,7 +18,8 @@ def box(x0, y0, z0, x1, y1, z1):
     return [(x, y, z) for x in (x0, x1) for y in (y0, y1) for z in (z0, z1)]
 
 
-def build(collider='MSC', engines=()):
+def build(collider='MSC', engines=(), rigidTop=False):
+    """rigidTop: the top block of the stack is rigid (6 unknowns)."""
     O.reset()
     slippery = O.materials.append(wrapper.PolyhedraMat(young=1e8, poisson=0.25, density=2600,
                                                        frictionAngle=math.radians(20)))
@@ -28,7 +29,7 @@ def build(collider='MSC', engines=()):
     O.bodies.append(ddaBlock(box(2.5, -5, -1, 20, 5, 0), material=rough, fixed=True))
     O.bodies.append(ddaBlock(box(-0.5, -0.5, 0, 0.5, 0.5, 1), material=slippery))
     O.bodies.append(ddaBlock(box(4, -0.5, 0, 5, 0.5, 1), material=rough))
-    O.bodies.append(ddaBlock(box(4.1, -0.4, 1, 4.9, 0.4, 1.8), material=rough))
+    O.bodies.append(ddaBlock(box(4.1, -0.4, 1, 4.9, 0.4, 1.8), material=rough, rigid=rigidTop))
     tilt = math.radians(30)
     O.engines = [DDAIntegrator(dt=1e-3, gravity=(9.81 * math.sin(tilt), 0, -9.81 * math.cos(tilt)),
                                maxDisplacement=0.01, collider=collider)] + list(engines)

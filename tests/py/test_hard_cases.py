@@ -166,15 +166,7 @@ def test_overlap_depth_matches_closed_forms():
 
 # ================================================================ degenerate geometry
 
-# Cases that fail on a core fault (diagnosed in the docstring of each reason; the
-# fixes are outside what this suite may change). Strict: once the core is
-# fixed they pass, the xfail fails, and the marker must go.
-NARROW_PHASE_LINE_CONTACT = pytest.mark.xfail(strict=True, reason=(
-    'core fault, narrow phase (PairDetection): an edge entrance gives one edge-edge sub-contact only, also '
-    'when the edge lies almost in a face of the other block (a line contact, here the lower cube\'s edge '
-    'along the upper cube\'s face, 1e-3 rad apart); the edge\'s end corner (the apex) is no contact and '
-    'sinks 1.76e-4 m into that face at step 345 (tolerance 1.42e-4 m), then is thrown out (3300 J lost)'))
-CORNER_DROPS = ['aligned', 'apex', pytest.param('apex-turned', marks=NARROW_PHASE_LINE_CONTACT)]
+CORNER_DROPS = ['aligned', 'apex', 'apex-turned']
 
 
 @pytest.mark.parametrize('placement', CORNER_DROPS)

@@ -88,6 +88,24 @@ def test_save_load_continue_is_bitwise(scene, reference, tmp_path, form):
     _compare(saveload_scene.state(), reference[1])
 
 
+def test_rigid_block_stays_rigid_across_save_load(scene, tmp_path):
+    """A rigid block's flag is part of the saved state: loaded, it keeps 6
+    unknowns and no strain, and the run continues bitwise."""
+    saveload_scene.build(rigidTop=True)
+    O.run(N + M, True)
+    want = saveload_scene.state()
+    saveload_scene.build(rigidTop=True)
+    O.run(N, True)
+    O.save(str(tmp_path / 'rigid.yade'))
+    O.run(7, True)
+    O.load(str(tmp_path / 'rigid.yade'))
+    assert yade_dda.block(O.bodies[4]).rigid and not yade_dda.block(O.bodies[3]).rigid
+    O.run(M, True)
+    assert yade_dda.stats()['rigidBlocks'] == 1
+    assert all(x == 0 for x in yade_dda.block(O.bodies[4]).strain)
+    _compare(saveload_scene.state(), want)
+
+
 def test_load_replaces_the_live_core_scene(scene, tmp_path):
     saveload_scene.build()
     O.run(5, True)
@@ -187,8 +205,8 @@ BAD_STATES = {
     'other tag format': (lambda text, info, core: text.replace(saveload.FORMAT, 'yade_dda-state/9', 1),
                          'format yade_dda-state/9; this yade_dda reads yade_dda-state/1'),
     'not a state': (lambda text, info, core: 'hello', 'does not hold a yade_dda state'),
-    'core version': (lambda text, info, core: _encode(info, core[:16] + struct.pack('<I', 2) + core[20:]),
-                     'format version 2; this build of yade_dda reads version 1'),
+    'core version': (lambda text, info, core: _encode(info, core[:16] + struct.pack('<I', 3) + core[20:]),
+                     'format version 3; this build of yade_dda reads version 2'),
     'core checksum': (lambda text, info, core: _encode(info, _flip(core, len(core) // 2)),
                       'checksum does not match'),
     'core truncated': (lambda text, info, core: _encode(info, core[:-100]), 'truncated or padded'),

@@ -58,6 +58,11 @@ struct Block {
 	Material material;
 	Matrix6 elasticity = Matrix6::Zero();  // of the material [Pa]
 	bool fixed = false;  // a fixed block has no unknowns: it never moves
+	// A rigid block has 6 unknowns (translation, rotation): no strain, no
+	// stress, no elastic term. Its strain unknowns and rates stay exactly zero
+	// in the 12-vector layout, so contact code needs no special case.
+	bool rigid = false;
+	int unknowns() const { return fixed ? 0 : rigid ? kRigidBlockDofs : kBlockDofs; }
 	std::vector<FixedPoint> fixedPoints;
 	std::vector<PointLoad> loads;
 	// Sum of |strain increment| since the YADE body's vertices were last

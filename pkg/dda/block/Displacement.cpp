@@ -36,6 +36,18 @@ Matrix12 massMatrix(double density, double volume, const Matrix3& J) {
 	return M;
 }
 
+Matrix6 rigidMassMatrix(double density, double volume, const Matrix3& J) {
+	// The same sum as massMatrix, over the rotation rows and columns only
+	// (each P_k's top-left 3x3), so the two agree to the last bit.
+	const auto& P = secondMomentCoefficients();
+	Matrix6 M = Matrix6::Zero();
+	M.block<3, 3>(0, 0).diagonal().setConstant(density * volume);
+	M.block<3, 3>(3, 3) = density * (J(0, 0) * P[0].topLeftCorner<3, 3>() + J(1, 1) * P[1].topLeftCorner<3, 3>() +
+	                                 J(2, 2) * P[2].topLeftCorner<3, 3>() + J(0, 1) * P[3].topLeftCorner<3, 3>() +
+	                                 J(1, 2) * P[4].topLeftCorner<3, 3>() + J(2, 0) * P[5].topLeftCorner<3, 3>());
+	return M;
+}
+
 Matrix6 elasticityMatrix(double young, double poisson) {
 	const double lambda = young * poisson / ((1 + poisson) * (1 - 2 * poisson));
 	const double shear = young / (2 * (1 + poisson));

@@ -28,7 +28,10 @@ using Vector12 = Eigen::Matrix<double, 12, 1>;
 using Matrix12 = Eigen::Matrix<double, 12, 12>;
 using Matrix3x12 = Eigen::Matrix<double, 3, 12>;
 
+using Matrix3x6 = Eigen::Matrix<double, 3, 6>;
+
 constexpr int kBlockDofs = 12;
+constexpr int kRigidBlockDofs = 6;  // translation and rotation only (a rigid block)
 
 // T(d): displacement of the point at offset d from the centroid per unit of each unknown.
 inline Matrix3x12 displacementMatrix(const Vector3& d) {
@@ -92,6 +95,11 @@ inline Vector6 stressVoigt(const Matrix3& t) {
 // and the integral of d over the block zero (d is measured from the centroid):
 //   M = rho [[V I, 0], [0, sum_kl J_kl B_k^T B_l]],  B_k = dB/dd_k.
 Matrix12 massMatrix(double density, double volume, const Matrix3& secondMoment);
+
+// The translation-rotation block of massMatrix (its top-left 6x6, computed
+// alone and bitwise equal to it): rho [[V I, 0], [0, tr(J) I - J]], the mass
+// matrix of a rigid block.
+Matrix6 rigidMassMatrix(double density, double volume, const Matrix3& secondMoment);
 
 // Isotropic linear elastic stiffness in Voigt form (engineering shear) [Pa].
 // Requires young > 0 and -1 < poisson < 0.5 (checked by the caller).

@@ -635,6 +635,36 @@ void faceEntranceContacts(const Prepared& owner, bool ownerIsA, int f, const Pre
 	}
 }
 
+// Step 3 for an edge entrance, after its crossing (out[0]): the features the
+// best face axis finds within d0 elsewhere. Two blocks touching edge on edge
+// near one corner can have a far corner within d0 too (a cube tilting onto
+// another: it rocks on the crossing and its far corner comes down); with the
+// crossing alone that corner would enter the other block unopposed in the
+// step. What the face finds at the crossing itself (the same edge pair, or a
+// corner or crossing within the corner merge distance of it) is the crossing's
+// contact and is left out.
+void otherFeaturesOfEdgeEntrance(const Prepared& a, const Prepared& b, const FaceCandidate& face,
+                                 const DetectionSettings& settings, double sinTolerance, Scratch& s,
+                                 std::vector<SubContact>& out) {
+	const SubContact crossing = out.front();
+	const std::size_t first = out.size();
+	if (face.feature.kind == EntranceFeature::FaceOfA)
+		faceEntranceContacts(a, true, face.feature.feature, b, face.separation, settings, sinTolerance, s, out);
+	else
+		faceEntranceContacts(b, false, face.feature.feature, a, face.separation, settings, sinTolerance, s, out);
+	const double merge = std::max(settings.cornerMergeDistance, settings.lengthTolerance);
+	const auto sameAsCrossing = [&](const SubContact& c) {
+		if (c.kind == ContactKind::EdgeEdge) {
+			const int edgeA = c.firstIsA ? c.feature1 : c.feature2, edgeB = c.firstIsA ? c.feature2 : c.feature1;
+			if (edgeA == crossing.feature1 && edgeB == crossing.feature2) return true;
+		}
+		for (const Vector3* p : {&c.pointI, &c.pointJ})
+			if ((*p - crossing.pointI).norm() <= merge || (*p - crossing.pointJ).norm() <= merge) return true;
+		return false;
+	};
+	out.erase(std::remove_if(out.begin() + static_cast<std::ptrdiff_t>(first), out.end(), sameAsCrossing), out.end());
+}
+
 // ------------------------------------------------------------ structural type
 
 enum class FeatureKind { Vertex, Edge, Face };
@@ -862,6 +892,8 @@ std::optional<PairContacts> detectPairContacts(const BlockGeometry& blockA, cons
 		if (c) {
 			out.normal = (previousEdge.valid && entrance == previous) ? previousEdge.normal : bestEdge.normal;
 			out.contacts.push_back(*c);
+			otherFeaturesOfEdgeEntrance(a, b, chooseFace(faces, a, b, tol, previous), settings, sinTolerance, s,
+			                            out.contacts);
 		} else {
 			const FaceCandidate& f = chooseFace(faces, a, b, tol, previous);
 			entrance = f.feature;

@@ -54,9 +54,15 @@
 //          other's edges right beside a corner that already has its contact;
 //          a crossing next to a corner with no contact, or pushing another
 //          way, stays).
-//      An edge entrance gives one edge-edge sub-contact (block i = A), or
+//      An edge entrance gives its edge-edge sub-contact (block i = A), or
 //      falls back to the best face when the two edges do not cross strictly
-//      inside. Edge-edge stencils take as reference direction (from block i
+//      inside. With the crossing, the best face (chosen as in step 2) adds
+//      the sub-contacts it finds by the rules above away from the crossing:
+//      a block rocking on a crossing near one corner can have its far
+//      corner within d0 as well, and with the crossing alone that corner
+//      would enter the other block unopposed. What the face finds at the
+//      crossing (the same edges, or a point within cornerMergeDistance of
+//      it) is left to the crossing. Edge-edge stencils take as reference direction (from block i
 //      towards block j) the sum of the outward normals of the faces at i's
 //      edge minus that at j's edge.
 //   4. Structural type from the contact features: on each block, the points

@@ -7,6 +7,10 @@
 namespace dda {
 
 void assembleBlock(const Block& block, const IntegratorSettings& settings, double dt, BlockSystem& system) {
+	if (block.rigid) {
+		assembleRigidBlock(block, settings, dt, system);
+		return;
+	}
 	const Vector12 v0 = startVelocity(block, settings);
 	const Matrix12 mass = massMatrix(block.density(), block.volume, block.secondMoment);
 	system.stiffness.noalias() = (2 / (dt * dt)) * mass;
@@ -28,9 +32,43 @@ void assembleBlock(const Block& block, const IntegratorSettings& settings, doubl
 		system.force.noalias() += displacementMatrix(load.position - block.centroid).transpose() * load.force;
 }
 
+void assembleRigidBlock(const Block& block, const IntegratorSettings& settings, double dt, BlockSystem& system) {
+	// Only the translation-rotation rows and columns are computed; the strain
+	// part of the 12x12 system is zero and never read (solveBlock and
+	// CoupledSystem take the first 6 unknowns of a rigid block).
+	const Vector6 v0 = startVelocity(block, settings).head<6>();
+	const Matrix6 mass = rigidMassMatrix(block.density(), block.volume, block.secondMoment);
+	system.stiffness.setZero();
+	system.force.setZero();
+	auto stiffness = system.stiffness.topLeftCorner<6, 6>();
+	auto force = system.force.head<6>();
+	stiffness.noalias() = (2 / (dt * dt)) * mass;
+	force.noalias() = (2 / dt) * (mass * v0);
+	if (!settings.gravity.isZero()) force.head<3>() += block.mass * settings.gravity;
+	for (const FixedPoint& point : block.fixedPoints) {
+		const Matrix3x6 T = displacementMatrix(point.position - block.centroid).leftCols<6>();
+		const double k = point.stiffness > 0 ? point.stiffness
+		                                     : settings.fixedPointPenaltyFactor * block.material.young * block.size;
+		stiffness.noalias() += k * T.transpose() * T;
+		force.noalias() += k * T.transpose() * (point.anchor - point.position);
+	}
+	for (const PointLoad& load : block.loads)
+		force.noalias() += displacementMatrix(load.position - block.centroid).leftCols<6>().transpose() * load.force;
+}
+
 Vector12 solveBlock(const Block& block, const BlockSystem& system) {
-	if (!block.fixedPoints.empty()) return system.stiffness.llt().solve(system.force);
 	Vector12 D;
+	if (block.rigid) {
+		D.tail<6>().setZero();
+		if (!block.fixedPoints.empty()) {
+			D.head<6>() = system.stiffness.topLeftCorner<6, 6>().llt().solve(system.force.head<6>());
+		} else {
+			D.head<3>() = system.force.head<3>().cwiseQuotient(system.stiffness.diagonal().head<3>());
+			D.segment<3>(3) = system.stiffness.block<3, 3>(3, 3).llt().solve(system.force.segment<3>(3));
+		}
+		return D;
+	}
+	if (!block.fixedPoints.empty()) return system.stiffness.llt().solve(system.force);
 	D.head<3>() = system.force.head<3>().cwiseQuotient(system.stiffness.diagonal().head<3>());
 	D.tail<9>() = system.stiffness.block<9, 9>(3, 3).llt().solve(system.force.tail<9>());
 	return D;
@@ -55,7 +93,8 @@ double largestVertexDisplacement(const Block& block, const Vector12& D) {
 BlockMotion blockMotion(const Block& block, const Vector12& D) {
 	BlockMotion motion;
 	motion.rotation = rotationFromVector(D.segment<3>(3));
-	motion.deformation = (Matrix3::Identity() + strainTensor(D.segment<6>(6))) * motion.rotation;
+	motion.deformation =
+	    block.rigid ? motion.rotation : Matrix3((Matrix3::Identity() + strainTensor(D.segment<6>(6))) * motion.rotation);
 	motion.oldCentroid = block.centroid;
 	motion.newCentroid = block.centroid + D.head<3>();
 	return motion;
@@ -70,14 +109,24 @@ void applyStep(Block& block, const Vector12& D, const Vector12& v0, double dt) {
 	for (Vector3& x : block.vertices) x = move(x);
 	for (FixedPoint& point : block.fixedPoints) point.position = move(point.position);
 	for (PointLoad& load : block.loads) load.position = move(load.position);
+	block.centroid = newCentroid;
+	block.rotation = (Eigen::Quaterniond(rotation) * block.rotation).normalized();
+
+	if (block.rigid) {
+		// Rigid motion: the volume is unchanged (det R = 1 up to round-off,
+		// which is not applied), the second moments turn with the block;
+		// stress, strain and strain rates stay exactly zero.
+		block.secondMoment = rotation * block.secondMoment * rotation.transpose();
+		block.velocity.head<6>() = (2 / dt) * D.head<6>() - v0.head<6>();
+		block.velocity.tail<6>().setZero();
+		return;
+	}
 
 	// An affine map x -> c' + L (x - c) maps the centroid to c' and scales
 	// volume by det L; the second moments transform as det(L) L J L^T (exact).
 	const double jacobian = deformation.determinant();
-	block.centroid = newCentroid;
 	block.volume *= jacobian;
 	block.secondMoment = jacobian * deformation * block.secondMoment * deformation.transpose();
-	block.rotation = (Eigen::Quaterniond(rotation) * block.rotation).normalized();
 
 	// End velocity of the step; tensors follow the block's rotation.
 	Vector12 velocity = (2 / dt) * D - v0;

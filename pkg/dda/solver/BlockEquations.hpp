@@ -31,10 +31,17 @@ inline Vector12 startVelocity(const Block& block, const IntegratorSettings& sett
 }
 
 void assembleBlock(const Block& block, const IntegratorSettings& settings, double dt, BlockSystem& system);
+// A rigid block's system (assembleBlock calls it): inertia, gravity, fixed
+// points and loads in the 6 translation-rotation unknowns only, computed as
+// 6x6 (rigidMassMatrix, T's first 6 columns); no elastic or stress term. The
+// strain rows and columns of `system` are left zero.
+void assembleRigidBlock(const Block& block, const IntegratorSettings& settings, double dt, BlockSystem& system);
 
 // Solves the block's system. Without fixed points the translations decouple
 // (the first moments about the centroid vanish), leaving a 3x3 diagonal and a
-// 9x9 system; otherwise the full 12x12 one. Both by Cholesky (K is SPD).
+// 9x9 system; otherwise the full 12x12 one. Both by Cholesky (K is SPD). A
+// rigid block: 3 + 3 (diagonal and rotation 3x3), or 6x6 with fixed points;
+// its strain unknowns are returned exactly zero.
 Vector12 solveBlock(const Block& block, const BlockSystem& system);
 
 // Largest displacement of a vertex for the unknowns D [m]; +inf when D or a
@@ -55,6 +62,8 @@ BlockMotion blockMotion(const Block& block, const Vector12& D);
 // Applies an accepted step: exact rotation about the centroid, then the strain,
 // to vertices, supports, loads and mass properties; new velocity; stress update
 // (the old stress rotated with the block plus E times the strain increment).
+// A rigid block: rotation and translation only; volume kept, second moments
+// turned (R J R^T), stress, strain and strain rates left exactly zero.
 void applyStep(Block& block, const Vector12& D, const Vector12& startVelocity, double dt);
 
 }  // namespace dda

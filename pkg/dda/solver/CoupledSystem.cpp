@@ -27,8 +27,9 @@ int findRoot(std::vector<int>& parent, int k) {
 }  // namespace
 
 void CoupledSystem::build(int movingBlocks, const std::vector<std::pair<int, int>>& links,
-                          const std::vector<char>& hasSprings) {
+                          const std::vector<char>& hasSprings, const std::vector<int>& unknowns) {
 	hasSprings_ = hasSprings;
+	unknowns_ = unknowns;
 	std::vector<int> parent(movingBlocks);
 	std::iota(parent.begin(), parent.end(), 0);
 	offDiagonalIndex_.clear();
@@ -60,6 +61,7 @@ void CoupledSystem::build(int movingBlocks, const std::vector<std::pair<int, int
 	for (int slot = 0; slot < static_cast<int>(offDiagonalPairs_.size()); ++slot)
 		componentLinks_[componentOf_[offDiagonalPairs_[slot].first]].push_back(slot);
 	offDiagonal_.resize(offDiagonalPairs_.size());
+	componentUnknowns_.assign(components_.size(), 0);
 	diagonal_.resize(movingBlocks);
 	force_.resize(movingBlocks);
 }
@@ -91,8 +93,17 @@ void CoupledSystem::solve(const std::vector<const Block*>& blocks, std::vector<V
 		const std::vector<int>& members = components_[c];
 		if (members.size() == 1) {
 			const int k = members[0];
+			componentUnknowns_[c] = unknowns_[k];
 			if (!hasSprings_[k]) {
 				solutions[k] = solveBlock(*blocks[k], BlockSystem{diagonal_[k], force_[k]});
+			} else if (unknowns_[k] == kRigidBlockDofs) {
+				Eigen::LLT<Matrix6> llt(diagonal_[k].topLeftCorner<kRigidBlockDofs, kRigidBlockDofs>());
+				if (llt.info() != Eigen::Success) {
+#pragma omp atomic write
+					failed = true;
+				}
+				solutions[k].head<kRigidBlockDofs>() = llt.solve(force_[k].head<kRigidBlockDofs>());
+				solutions[k].tail<kBlockDofs - kRigidBlockDofs>().setZero();
 			} else {
 				Eigen::LLT<Matrix12> llt(diagonal_[k]);
 				if (llt.info() != Eigen::Success) {
@@ -103,25 +114,31 @@ void CoupledSystem::solve(const std::vector<const Block*>& blocks, std::vector<V
 			}
 			continue;
 		}
-		const int n = kBlockDofs * static_cast<int>(members.size());
+		// Variable block sizes: member l's unknowns start at offset[l] and
+		// number unknowns_[k] (12, or 6 for a rigid block, whose strain rows
+		// and columns of the stored 12x12 blocks are left out).
+		std::vector<int> offset(members.size() + 1, 0);
+		for (std::size_t l = 0; l < members.size(); ++l) offset[l + 1] = offset[l] + unknowns_[members[l]];
+		const int n = offset.back();
+		componentUnknowns_[c] = n;
 		std::vector<Eigen::Triplet<double>> entries;
 		entries.reserve(members.size() * 78 + componentLinks_[c].size() * 144);
 		Eigen::VectorXd rhs(n);
 		for (std::size_t l = 0; l < members.size(); ++l) {
 			const int k = members[l];
-			const int base = kBlockDofs * static_cast<int>(l);
-			for (int col = 0; col < kBlockDofs; ++col)
-				for (int row = col; row < kBlockDofs; ++row)
-					entries.emplace_back(base + row, base + col, diagonal_[k](row, col));
-			rhs.segment<kBlockDofs>(base) = force_[k];
+			const int base = offset[l], size = unknowns_[k];
+			for (int col = 0; col < size; ++col)
+				for (int row = col; row < size; ++row) entries.emplace_back(base + row, base + col, diagonal_[k](row, col));
+			rhs.segment(base, size) = force_[k].head(size);
 		}
 		for (int slot : componentLinks_[c]) {
 			// Stored block is K[lo][hi]; the lower triangle holds K[hi][lo] = its transpose.
 			const auto [lo, hi] = offDiagonalPairs_[slot];
-			const int rowBase = kBlockDofs * localIndex_[hi], colBase = kBlockDofs * localIndex_[lo];
+			const int rowBase = offset[localIndex_[hi]], colBase = offset[localIndex_[lo]];
+			const int rows = unknowns_[hi], cols = unknowns_[lo];
 			const Matrix12& m = offDiagonal_[slot];
-			for (int col = 0; col < kBlockDofs; ++col)
-				for (int row = 0; row < kBlockDofs; ++row) entries.emplace_back(rowBase + row, colBase + col, m(col, row));
+			for (int col = 0; col < cols; ++col)
+				for (int row = 0; row < rows; ++row) entries.emplace_back(rowBase + row, colBase + col, m(col, row));
 		}
 		Eigen::SparseMatrix<double> K(n, n);
 		K.setFromTriplets(entries.begin(), entries.end());
@@ -132,10 +149,17 @@ void CoupledSystem::solve(const std::vector<const Block*>& blocks, std::vector<V
 			continue;
 		}
 		const Eigen::VectorXd x = llt.solve(rhs);
-		for (std::size_t l = 0; l < members.size(); ++l)
-			solutions[members[l]] = x.segment<kBlockDofs>(kBlockDofs * static_cast<int>(l));
+		for (std::size_t l = 0; l < members.size(); ++l) {
+			const int k = members[l], size = unknowns_[k];
+			solutions[k].setZero();
+			solutions[k].head(size) = x.segment(offset[l], size);
+		}
 	}
 	if (failed) throw std::runtime_error("the DDA system is not positive definite (Cholesky failed)");
+	// Summed in component order after the loop, so the count does not depend
+	// on the thread count.
+	solvedUnknowns_ = 0;
+	for (int c = 0; c < count; ++c) solvedUnknowns_ += componentUnknowns_[c];
 }
 
 }  // namespace dda

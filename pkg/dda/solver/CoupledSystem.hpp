@@ -12,6 +12,15 @@
 //   - several blocks: a sparse Cholesky (Eigen's SimplicialLLT, AMD order).
 // K is symmetric positive definite: the mass term is, and springs add
 // positive semi-definite terms.
+//
+// Rigid blocks have 6 unknowns, not 12. Every block keeps the 12-layout in
+// storage (contact terms are assembled as for any block), but a rigid block's
+// strain rows and columns never enter a factorisation: its own solve is 3 + 3
+// or 6x6, and in a sparse component the unknowns are numbered with variable
+// block sizes (offsets), the strain rows and columns of its stored blocks
+// skipped. Leaving them out is exactly the constraint strain = 0 (the
+// restriction of the quadratic energy to the rigid subspace); its solution's
+// strain part is set to zero.
 #pragma once
 
 #include "BlockEquations.hpp"
@@ -30,8 +39,10 @@ public:
 	// Sets the structure: `links` lists pairs of moving-block indices
 	// (0 .. movingBlocks-1) joined by a closed contact; `hasSprings[k]` says
 	// whether block k has closed contacts or fixed points (so needs the 12x12
-	// solve).
-	void build(int movingBlocks, const std::vector<std::pair<int, int>>& links, const std::vector<char>& hasSprings);
+	// solve); `unknowns[k]` is its number of unknowns (kBlockDofs, or
+	// kRigidBlockDofs for a rigid block).
+	void build(int movingBlocks, const std::vector<std::pair<int, int>>& links, const std::vector<char>& hasSprings,
+	           const std::vector<int>& unknowns);
 
 	// Starts an assembly from the blocks' own systems.
 	void reset(const std::vector<BlockSystem>& blockSystems);
@@ -48,11 +59,16 @@ public:
 
 	int components() const { return static_cast<int>(components_.size()); }
 	int largestComponent() const;
+	// Unknowns factorised by the last solve, all components together.
+	long solvedUnknowns() const { return solvedUnknowns_; }
 
 private:
 	std::vector<std::vector<int>> components_;  // moving-block indices, ascending
 	std::vector<int> componentOf_, localIndex_;
 	std::vector<char> hasSprings_;
+	std::vector<int> unknowns_;           // per moving block: 12, or 6 when rigid
+	std::vector<long> componentUnknowns_;  // per component, of the last solve
+	long solvedUnknowns_ = 0;
 	std::vector<Matrix12> diagonal_;
 	std::vector<Vector12> force_;
 	std::vector<Matrix12> offDiagonal_;

@@ -76,7 +76,10 @@ struct StepStatistics {
 	double allowedDisplacement = 0;  // bound used [m]
 	int blocks = 0;                  // all blocks
 	int movingBlocks = 0;            // blocks with unknowns
-	int unknowns = 0;                // size of the system solved
+	int unknowns = 0;                // size of the system solved: 12 per moving block, 6 per rigid one
+	int rigidBlocks = 0;             // moving blocks that are rigid (6 unknowns: no strain, no stress)
+	int strainUnknowns = 0;          // strain unknowns in the system (6 per deformable moving block)
+	long solvedUnknowns = 0;         // unknowns the last solve factorised, all components (= unknowns)
 	// contacts
 	double contactDistance = 0;      // d0 used [m]
 	long candidatePairs = 0;         // block pairs from the broad phase

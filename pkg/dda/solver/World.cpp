@@ -142,12 +142,12 @@ double projectedHullArea(const std::vector<Vector3>& points, const Vector3& norm
 }
 }  // namespace
 
-int World::addBlock(const std::vector<Vector3>& points, const Material& material, bool fixed) {
-	blocks_.push_back(makeBlock(points, material, fixed));
+int World::addBlock(const std::vector<Vector3>& points, const Material& material, bool fixed, bool rigid) {
+	blocks_.push_back(makeBlock(points, material, fixed, rigid));
 	return blockCount() - 1;
 }
 
-Block makeBlock(const std::vector<Vector3>& points, const Material& material, bool fixed) {
+Block makeBlock(const std::vector<Vector3>& points, const Material& material, bool fixed, bool rigid) {
 	validateMaterial(material);
 	auto shape = std::make_shared<const ConvexPolyhedron>(buildConvexPolyhedron(points));
 	const MassProperties properties = computeMassProperties(shape->vertices, shape->faces);
@@ -162,6 +162,7 @@ Block makeBlock(const std::vector<Vector3>& points, const Material& material, bo
 	block.material = material;
 	block.elasticity = elasticityMatrix(material.young, material.poisson);
 	block.fixed = fixed;
+	block.rigid = rigid;
 	return block;
 }
 
@@ -203,7 +204,14 @@ void World::setVelocity(int index, const Vector3& velocity, const Vector3& angul
 
 void World::setStress(int index, const Vector6& stress) {
 	if (!stress.allFinite()) throw InputError("initial stress must be finite");
-	block(index).stress = stress;
+	Block& b = block(index);
+	if (b.rigid && !stress.isZero()) {
+		std::ostringstream message;
+		message << "block " << index << " is rigid: it has no strain and carries no stress, so it cannot be given an "
+		        << "initial stress (got (" << stress.transpose() << ") Pa)";
+		throw InputError(message.str());
+	}
+	b.stress = stress;
 }
 
 double World::sceneHalfSize() {
@@ -354,7 +362,7 @@ void World::buildSystemStructure(int movingBlocks, StepStatistics& stats) {
 		if (mj >= 0) hasSprings_[mj] = 1;
 		if (mi >= 0 && mj >= 0) links_.emplace_back(mi, mj);
 	}
-	coupled_.build(movingBlocks, links_, hasSprings_);
+	coupled_.build(movingBlocks, links_, hasSprings_, blockUnknowns_);
 	++stats.systemStructures;
 	stats.components = coupled_.components();
 	stats.largestComponent = coupled_.largestComponent();
@@ -399,7 +407,14 @@ double World::step(const IntegratorSettings& settings) {
 	}
 	const int n = static_cast<int>(moving_.size());
 	stats.movingBlocks = n;
-	stats.unknowns = kBlockDofs * n;
+	blockUnknowns_.resize(n);
+	for (int k = 0; k < n; ++k) {
+		const Block& b = blocks_[moving_[k]];
+		blockUnknowns_[k] = b.unknowns();
+		stats.unknowns += b.unknowns();
+		stats.rigidBlocks += b.rigid;
+		stats.strainUnknowns += b.unknowns() - kRigidBlockDofs;
+	}
 	systems_.resize(n);
 	solutions_.resize(n);
 	startVelocities_.resize(n);
@@ -444,6 +459,7 @@ double World::step(const IntegratorSettings& settings) {
 			stats.timeAssembly += secondsSince(phase);
 			phase = Clock::now();
 			coupled_.solve(movingBlocks_, solutions_, kMinBlocksForThreads);
+			stats.solvedUnknowns = coupled_.solvedUnknowns();
 			stats.timeSolve += secondsSince(phase);
 			++iterations;
 			changes = 0;

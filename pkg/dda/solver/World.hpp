@@ -20,12 +20,13 @@ class StateReader;
 
 // A block at rest built from its corners [m] and material, not in any world
 // (throws InputError naming the problem). World::addBlock adds one.
-Block makeBlock(const std::vector<Vector3>& points, const Material& material, bool fixed);
+Block makeBlock(const std::vector<Vector3>& points, const Material& material, bool fixed, bool rigid = false);
 
 class World {
 public:
 	// Builds and validates a block (throws InputError; the world is unchanged then).
-	int addBlock(const std::vector<Vector3>& points, const Material& material, bool fixed);
+	// A rigid block has 6 unknowns (translation, rotation) and no strain or stress.
+	int addBlock(const std::vector<Vector3>& points, const Material& material, bool fixed, bool rigid = false);
 	int blockCount() const { return static_cast<int>(blocks_.size()); }
 	Block& block(int index);
 	const Block& block(int index) const;
@@ -89,6 +90,7 @@ private:
 	std::vector<Vector3> points_;
 	std::vector<std::pair<int, int>> links_;  // buildSystemStructure's work arrays
 	std::vector<char> hasSprings_;
+	std::vector<int> blockUnknowns_;  // per moving block: 12, or 6 when rigid
 	std::vector<Block> blocks_;
 	StepStatistics stats_;
 	double nextTimeStep_ = 0;  // dt to try first in the next step; 0 = maxTimeStep

@@ -5,8 +5,8 @@
 // would differ if re-measured from moved blocks); the flush-joint faces; the
 // last step's statistics; the collider (its name and, for MSC, its covers);
 // every block (topology, current vertices, mass properties, rotation, 12
-// rates, stress, strain, material, supports and loads); every sub-contact of
-// the last step with its geometry, mechanics and history, in store order, and
+// rates, stress, strain, material, fixed and rigid flags, supports and
+// loads); every sub-contact of the last step with its geometry, mechanics and history, in store order, and
 // the pairs' entrance features. What is not written is rebuilt identically at
 // the start of the next step: the contact store's history index (from the
 // contacts), the coupled system, and the per-step work arrays.
@@ -70,6 +70,7 @@ void writeBlock(StateWriter& out, const Block& b) {
 	for (double x : {m.density, m.young, m.poisson, m.frictionAngle, m.cohesion, m.tensileStrength}) out.pod(x);
 	out.matrix(b.elasticity);
 	out.pod(static_cast<std::uint8_t>(b.fixed));
+	out.pod(static_cast<std::uint8_t>(b.rigid));
 	out.size(b.fixedPoints.size());
 	for (const FixedPoint& p : b.fixedPoints) {
 		out.matrix(p.position);
@@ -102,6 +103,7 @@ Block readBlock(StateReader& in) {
 	for (double* x : {&m.density, &m.young, &m.poisson, &m.frictionAngle, &m.cohesion, &m.tensileStrength}) in.pod(*x);
 	in.matrix(b.elasticity);
 	b.fixed = in.pod<std::uint8_t>() != 0;
+	b.rigid = in.pod<std::uint8_t>() != 0;
 	b.fixedPoints.resize(in.size(7 * sizeof(double), "fixed points"));
 	for (FixedPoint& p : b.fixedPoints) {
 		in.matrix(p.position);
