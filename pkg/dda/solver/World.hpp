@@ -52,8 +52,8 @@ private:
 	// closed contacts carry terms, so only they join blocks into components
 	// (an open contact within d0 couples nothing until it closes).
 	void buildSystemStructure(int movingBlocks, StepStatistics& stats);
-	// Adds the trial-state terms of every contact to coupled_.
-	void assembleContacts();
+	// Adds the trial-state terms of every contact to coupled_ (counted in stats).
+	void assembleContacts(StepStatistics& stats);
 	const Vector12& unknowns(int block) const;
 	const Vector12& startRates(int block) const;  // rates at the start of the step, zero for fixed blocks
 	std::unique_ptr<Collider> collider_ = std::make_unique<DESSCollider>();
