@@ -44,6 +44,7 @@ bench: install
 	$(PYTHON) bench/free_blocks.py
 	$(PYTHON) bench/contacts.py
 	$(PYTHON) bench/colliders.py
+	$(PYTHON) bench/effects.py
 
 # Batch regressions (README, "Batch regressions"): yade-batch runs every row of a table in
 # examples/regression, each scene writes a record, check.py compares them with closed forms and

@@ -267,7 +267,6 @@ const Vector12& World::unknowns(int block) const {
 
 void World::detectContacts(const IntegratorSettings& settings, StepStatistics& stats) {
 	auto phase = Clock::now();
-	store_.beginStep();
 	BroadPhaseStatistics broad;
 	collider_->setPairReuse(settings.reuseCandidatePairs);
 	collider_->findPairs(blocks_, stats.contactDistance, pairs_, broad);
@@ -284,6 +283,7 @@ void World::detectContacts(const IntegratorSettings& settings, StepStatistics& s
 	stats.timeBroadPhase = secondsSince(phase);
 
 	phase = Clock::now();
+	store_.beginStep();  // the contact store's work, timed with the narrow phase
 	if (internalFacesBlocks_ != blockCount()) {
 		markInternalFaces(blocks_, internalFaces_);
 		internalFacesBlocks_ = blockCount();
