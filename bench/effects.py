@@ -15,6 +15,7 @@ Run: /usr/bin/python3 bench/effects.py [--quick]  (make bench runs it).
 import argparse
 import glob
 import importlib.util
+import inspect
 import json
 import math
 import os
@@ -188,11 +189,8 @@ def extra_rows(quick):
         spec = importlib.util.spec_from_file_location(name, path)
         module = importlib.util.module_from_spec(spec)
         spec.loader.exec_module(module)
-        try:
-            found = module.rows(quick=quick)
-        except TypeError:
-            found = module.rows()
-        out.extend(found)
+        takesQuick = 'quick' in inspect.signature(module.rows).parameters
+        out.extend(module.rows(quick=quick) if takesQuick else module.rows())
     return out
 
 
