@@ -275,6 +275,17 @@ py::dict lastStep(const SceneLink& s) {
 	d["components"] = st.components;
 	d["largestComponent"] = st.largestComponent;
 	d["systemStructures"] = st.systemStructures;
+	d["broadPhaseSkipped"] = st.broadPhaseSkipped;
+	d["pairsReused"] = st.pairsReused;
+	d["blocksResearched"] = st.blocksResearched;
+	d["fixedPairsSearched"] = st.fixedPairsSearched;
+	d["frictionTerms"] = st.frictionTerms;
+	d["normalTerms"] = st.normalTerms;
+	d["bodyForceBlocks"] = st.bodyForceBlocks;
+	d["frictionContacts"] = st.frictionContacts;
+	d["bondedContacts"] = st.bondedContacts;
+	d["fixedBlocks"] = st.fixedBlocks;
+	d["staticAnalysis"] = st.staticAnalysis;
 	py::dict times;
 	times["broadPhase"] = st.timeBroadPhase;
 	times["narrowPhase"] = st.timeNarrowPhase;
@@ -332,7 +343,8 @@ BOOST_PYTHON_MODULE(_core) {
 	    .def_readwrite("maxOpenCloseIterations", &IntegratorSettings::maxOpenCloseIterations)
 	    .def_readwrite("openCloseShrink", &IntegratorSettings::openCloseShrink)
 	    .def_readwrite("openCloseTolerance", &IntegratorSettings::openCloseTolerance)
-	    .def_readwrite("threads", &IntegratorSettings::threads);
+	    .def_readwrite("threads", &IntegratorSettings::threads)
+	    .def_readwrite("reuseCandidatePairs", &IntegratorSettings::reuseCandidatePairs);
 
 	py::class_<SceneLink, boost::noncopyable>("Scene", "The DDA state of one YADE scene; the core is the source of truth.")
 	    .def("addBlock", &addBlock,

@@ -157,6 +157,12 @@ class DDAIntegrator(wrapper.PyRunner):
       ``'AllPairs'`` (every pair: the reference, O(n^2)). All give the same
       contacts; only the time differs. A collider engine before the
       integrator (``DESSCollider``, ``NBSCollider``, ...) overrides it.
+    - ``reuseCandidatePairs``: diagnostic; True (default) lets the DESS
+      broad phase reuse its candidate pairs while no block has moved past
+      its allowance (d0 per box side), False searches every step. The
+      contacts are the same either way (``stats()['broadPhaseSkipped']``
+      counts the skipped searches); False exists to measure what the cache
+      saves.
     - ``syncPeriod``: write the DDA state into YADE's bodies every n steps; 0
       (default) = when something may read it: the last step of ``O.run(n)``,
       ``O.step()``, a step after which another periodic engine (a PyRunner
@@ -194,13 +200,16 @@ class DDAIntegrator(wrapper.PyRunner):
     collider = _Parameter('DESS', lambda v: _colliderName(v),
                           "broad phase: 'MSC' (multi-shell cover), 'DESS' (sorted boxes, default), 'NBS' (binned spheres) or "
                           "'AllPairs' (every pair, the oracle)")
+    reuseCandidatePairs = _Parameter(True, lambda v: bool(v),
+                                     'diagnostic: reuse broad-phase candidate pairs while blocks rest (same contacts)')
     openCloseTolerance = _Parameter(1e-9, lambda v: _finite('openCloseTolerance', v, 0),
                                     'opening gap of a closed contact / allowed step displacement [-]')
 
     _names = ('dt', 'gravity', 'velocityRatio', 'maxDisplacement', 'maxDisplacementRatio', 'timeStepGrowth',
               'maxStepCuts', 'fixedPointPenaltyFactor', 'threads', 'syncPeriod', 'contactDistance',
               'contactPenaltyFactor', 'shearStiffnessRatio', 'maxOpenCloseIterations', 'openCloseShrink',
-              'openCloseTolerance', 'collider')
+              'openCloseTolerance', 'collider',
+              'reuseCandidatePairs')
 
     def __init__(self, label='', **params):
         wrapper.PyRunner.__init__(self)
@@ -248,6 +257,7 @@ def _settings(params):
     settings.maxOpenCloseIterations = params['maxOpenCloseIterations']
     settings.openCloseShrink = params['openCloseShrink']
     settings.openCloseTolerance = params['openCloseTolerance']
+    settings.reuseCandidatePairs = params['reuseCandidatePairs']
     return settings
 
 

@@ -186,6 +186,17 @@ def stats():
     solve, update, core, sync. ``syncedBodies`` and ``syncs``
     (bodies written by the last sync, syncs so far), ``syncTimeTotal`` and
     ``stepTimeTotal`` [s] (all syncs; all integrator calls, sync included).
+
+    Work done or skipped: ``broadPhaseSkipped`` (1 when DESS reused its
+    cached candidate pairs instead of a sort-and-sweep), ``pairsReused``,
+    ``blocksResearched`` (blocks searched again; all on a full search),
+    ``fixedPairsSearched`` (pairs of two fixed blocks given to the narrow
+    phase: always 0), ``frictionTerms`` and ``normalTerms`` (shear springs or
+    friction loads, and normal springs, assembled over all solves of the
+    step), ``bodyForceBlocks`` (block assemblies with gravity),
+    ``frictionContacts`` (contacts with a friction coefficient > 0),
+    ``bondedContacts``, ``fixedBlocks``, ``staticAnalysis``
+    (velocityRatio == 0). ``effects`` sums them up, see ``effects()``.
     """
     scene = _require()
     result = scene.core.lastStep()
@@ -197,7 +208,21 @@ def stats():
     result['pendingBodies'] = sum(1 for body, _ in scene.pending if body.id >= 0)
     result['steps'] = scene.core.steps()
     result['collider'] = scene.core.collider()
+    result['effects'] = _effects(result)
     return result
+
+
+def _effects(s):
+    """Which effects the last step simulated, from its counters (see stats())."""
+    return {
+        'friction': s['frictionContacts'] > 0,          # some contact has a friction angle > 0
+        'gravity': s['bodyForceBlocks'] > 0,            # a body force was assembled
+        'static': bool(s['staticAnalysis']),            # velocityRatio == 0
+        'bonds': s['bondedContacts'] > 0,               # some contact is a bonded joint
+        'fixedBlocks': s['fixedBlocks'],                # blocks without unknowns (never paired together)
+        'restingReuse': bool(s['broadPhaseSkipped']),   # broad phase served from the pair cache
+        'rigidBlocks': s['rigidBlocks'],                # blocks with 6 unknowns
+    }
 
 
 def printStats():

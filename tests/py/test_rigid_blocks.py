@@ -182,6 +182,7 @@ def test_mixed_pile_of_rigid_and_deformable_blocks_is_stable(scene):
     for body in rigid:
         assert_unstrained(body)
     assert yade_dda.stats()['closedContacts'] > 0
+    assert yade_dda.stats()['effects']['rigidBlocks'] == 4
 
 
 def test_rigid_must_be_a_bool(scene):

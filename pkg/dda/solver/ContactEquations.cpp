@@ -96,6 +96,14 @@ double contactGap(const Contact& contact, const Vector12& Di, const Vector12& Dj
 	return contact.normal.d0 + contact.normal.ei.dot(Di) + contact.normal.ej.dot(Dj);
 }
 
+TangentialTerm tangentialTerm(const Contact& contact) {
+	const ContactHistory& trial = contact.trial;
+	if (trial.state == ContactState::Locked) return TangentialTerm::ShearSpring;
+	if (trial.state == ContactState::Sliding && contact.frictionTangent > 0 && trial.normalForce > 0)
+		return TangentialTerm::FrictionLoad;  // sliding: never bonded
+	return TangentialTerm::None;
+}
+
 bool contactTerms(const Contact& contact, const Block& blockI, const Block& blockJ, Matrix24& stiffness,
                   Vector24& force) {
 	const ContactHistory& trial = contact.trial;
@@ -106,13 +114,14 @@ bool contactTerms(const Contact& contact, const Block& blockI, const Block& bloc
 	force.noalias() = -kn * contact.normal.d0 * e;
 
 	const Vector3& n = contact.geometry.normal;
-	if (trial.state == ContactState::Locked) {
+	const TangentialTerm tangential = tangentialTerm(contact);
+	if (tangential == TangentialTerm::ShearSpring) {
 		const Eigen::Matrix<double, 3, 24> G = relativeDisplacementMatrix(blockI, trial.anchorI, blockJ, trial.anchorJ);
 		const Matrix3 P = tangentProjector(n);
 		const double ks = contact.shearStiffness;
 		stiffness.noalias() += ks * G.transpose() * P * G;
 		force.noalias() -= ks * G.transpose() * (P * (trial.anchorI - trial.anchorJ));
-	} else if (contact.frictionTangent > 0 && trial.normalForce > 0) {  // sliding: never bonded
+	} else if (tangential == TangentialTerm::FrictionLoad) {
 		const Eigen::Matrix<double, 3, 24> H =
 		    relativeDisplacementMatrix(blockI, contact.geometry.pointI, blockJ, contact.geometry.pointJ);
 		force.noalias() -= H.transpose() * (contact.frictionTangent * trial.normalForce * trial.slidingDirection);

@@ -59,6 +59,13 @@ void prepareContact(Contact& contact, const Block& blockI, const Block& blockJ, 
 bool contactTerms(const Contact& contact, const Block& blockI, const Block& blockJ, Matrix24& stiffness,
                   Vector24& force);
 
+// Which tangential term contactTerms adds for the contact's trial state: the
+// shear spring of a locked contact, the friction load of a sliding one with
+// friction and a compressive normal force, or none (open, or frictionless
+// sliding). World counts these (StepStatistics::frictionTerms).
+enum class TangentialTerm { None, ShearSpring, FrictionLoad };
+TangentialTerm tangentialTerm(const Contact& contact);
+
 // The trial state the solution implies; true when the state changed.
 // `openTolerance` [m] is the gap above which a closed contact opens.
 bool updateContactState(Contact& contact, const Block& blockI, const Block& blockJ, const Vector12& Di,

@@ -62,6 +62,11 @@ struct IntegratorSettings {
 	// chatter; the tension it lets through is kn times that gap).
 	double openCloseTolerance = 1e-9;
 
+	// Reuse the broad phase's candidate pairs across steps while no block has
+	// left its Verlet allowance (DESSCollider's cache). The contacts found do
+	// not depend on it; false is a diagnostic for comparing the work saved.
+	bool reuseCandidatePairs = true;
+
 	// Worker threads for per-block work; 0 = OpenMP's default. Results do not
 	// depend on the count.
 	int threads = 0;
@@ -104,6 +109,18 @@ struct StepStatistics {
 	int components = 0;              // independent systems of the last solve (moving blocks joined by closed contacts)
 	int largestComponent = 0;        // blocks in the largest one
 	int systemStructures = 0;        // times the system's structure was built (first solve, then after openings/closings)
+	// work done or skipped ("effects on demand")
+	long broadPhaseSkipped = 0;      // 1 when the broad phase reused cached pairs instead of a sort-and-sweep
+	long pairsReused = 0;            // cached candidate pairs reused without a search
+	long blocksResearched = 0;       // blocks searched against the others (all on a full search)
+	long fixedPairsSearched = 0;     // candidate pairs of two fixed blocks given to the narrow phase (always 0)
+	long frictionTerms = 0;          // shear springs and friction loads assembled, over all solves of the step
+	long normalTerms = 0;            // closed-contact normal springs assembled, over all solves of the step
+	long bodyForceBlocks = 0;        // block assemblies with a body force (gravity), over all attempts
+	int frictionContacts = 0;        // contacts of the step with a friction coefficient > 0
+	int bondedContacts = 0;          // contacts bonded at the end of the step
+	int fixedBlocks = 0;             // blocks without unknowns
+	bool staticAnalysis = false;     // velocityRatio == 0: velocities reset every step (Shi's static analysis)
 	// wall time per phase [s]
 	double timeBroadPhase = 0;
 	double timeNarrowPhase = 0;

@@ -277,8 +277,8 @@ const Vector12& World::ofBlock(const std::vector<Vector12>& perMovingBlock, int 
 
 void World::detectContacts(const IntegratorSettings& settings, StepStatistics& stats) {
 	auto phase = Clock::now();
-	store_.beginStep();
 	BroadPhaseStatistics broad;
+	collider_->setPairReuse(settings.reuseCandidatePairs);
 	collider_->findPairs(blocks_, stats.contactDistance, pairs_, broad);
 	stats.candidatePairs = broad.candidatePairs;
 	stats.shellPairs = broad.shellPairs;
@@ -286,9 +286,14 @@ void World::detectContacts(const IntegratorSettings& settings, StepStatistics& s
 	stats.shells = broad.shells;
 	stats.shellUpdates = broad.shellUpdates;
 	stats.subUnitPairs = broad.subUnitPairs;
+	stats.broadPhaseSkipped = broad.broadPhaseSkipped;
+	stats.pairsReused = broad.pairsReused;
+	stats.blocksResearched = broad.blocksResearched;
+	for (const auto& [a, b] : pairs_) stats.fixedPairsSearched += blocks_[a].fixed && blocks_[b].fixed;
 	stats.timeBroadPhase = secondsSince(phase);
 
 	phase = Clock::now();
+	store_.beginStep();  // the contact store's work, timed with the narrow phase
 	if (internalFacesBlocks_ != blockCount()) {
 		markInternalFaces(blocks_, internalFaces_);
 		internalFacesBlocks_ = blockCount();
@@ -345,6 +350,7 @@ void World::detectContacts(const IntegratorSettings& settings, StepStatistics& s
 			Contact& contact = store_.add(key, pair.type, sub, *blocks_[i].shape, *blocks_[j].shape);
 			contact.area = area;
 			prepareContact(contact, blocks_[i], blocks_[j], settings);
+			stats.frictionContacts += contact.frictionTangent > 0;
 		}
 	}
 	stats.contacts = static_cast<int>(store_.contacts().size());
@@ -368,12 +374,14 @@ void World::buildSystemStructure(int movingBlocks, StepStatistics& stats) {
 	stats.largestComponent = coupled_.largestComponent();
 }
 
-void World::assembleContacts() {
+void World::assembleContacts(StepStatistics& stats) {
 	Matrix24 stiffness;
 	Vector24 force;
 	for (const Contact& contact : store_.contacts()) {
 		const int bi = contact.key.blockI, bj = contact.key.blockJ;
 		if (!contactTerms(contact, blocks_[bi], blocks_[bj], stiffness, force)) continue;
+		++stats.normalTerms;
+		stats.frictionTerms += tangentialTerm(contact) != TangentialTerm::None;
 		const int mi = movingIndex_[bi], mj = movingIndex_[bj];
 		if (mi >= 0) {
 			coupled_.diagonal(mi) += stiffness.topLeftCorner<12, 12>();
@@ -407,6 +415,8 @@ double World::step(const IntegratorSettings& settings) {
 	}
 	const int n = static_cast<int>(moving_.size());
 	stats.movingBlocks = n;
+	stats.fixedBlocks = blockCount() - n;
+	stats.staticAnalysis = settings.velocityRatio == 0;
 	blockUnknowns_.resize(n);
 	for (int k = 0; k < n; ++k) {
 		const Block& b = blocks_[moving_[k]];
@@ -439,6 +449,8 @@ double World::step(const IntegratorSettings& settings) {
 #pragma omp parallel for schedule(static) if (n >= kMinBlocksForThreads)
 		for (int k = 0; k < n; ++k) assembleBlock(blocks_[moving_[k]], settings, dt, systems_[k]);
 		stats.timeAssembly += secondsSince(phase);
+		// assembleBlock adds a body force only for non-zero gravity.
+		if (!settings.gravity.isZero()) stats.bodyForceBlocks += n;
 
 		// Open-close iteration: solve with the trial contact states, update the
 		// states from the solution, until no state changes.
@@ -455,7 +467,7 @@ double World::step(const IntegratorSettings& settings) {
 			if (structureStale) buildSystemStructure(n, stats);
 			structureStale = false;
 			coupled_.reset(systems_);
-			assembleContacts();
+			assembleContacts(stats);
 			stats.timeAssembly += secondsSince(phase);
 			phase = Clock::now();
 			coupled_.solve(movingBlocks_, solutions_, kMinBlocksForThreads);
@@ -576,6 +588,7 @@ double World::step(const IntegratorSettings& settings) {
 			    std::max(stats.maxPenetration, -contactGap(contact, ofBlock(solutions_, bi), ofBlock(solutions_, bj)));
 		}
 		contact.history = trial;
+		stats.bondedContacts += trial.bonded;
 	}
 #pragma omp parallel for schedule(static) if (n >= kMinBlocksForThreads)
 	for (int k = 0; k < n; ++k) applyStep(blocks_[moving_[k]], solutions_[k], startVelocities_[k], dt);

@@ -68,8 +68,8 @@ private:
 	// closed contacts carry terms, so only they join blocks into components
 	// (an open contact within d0 couples nothing until it closes).
 	void buildSystemStructure(int movingBlocks, StepStatistics& stats);
-	// Adds the trial-state terms of every contact to coupled_.
-	void assembleContacts();
+	// Adds the trial-state terms of every contact to coupled_ (counted in stats).
+	void assembleContacts(StepStatistics& stats);
 	// A block's entry of a per-moving-block array (solutions_, startVelocities_);
 	// zero for fixed blocks.
 	const Vector12& ofBlock(const std::vector<Vector12>& perMovingBlock, int block) const;
