@@ -45,6 +45,7 @@ bench: install
 	$(PYTHON) bench/contacts.py
 	$(PYTHON) bench/colliders.py
 	$(PYTHON) bench/accuracy.py
+	$(PYTHON) bench/friction_startup.py
 	$(PYTHON) bench/effects.py
 
 # Batch regressions (README, "Batch regressions"): yade-batch runs every row of a table in

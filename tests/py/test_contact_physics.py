@@ -24,7 +24,9 @@ normalForce, shearForce) and stats()['maxPenetration'].
 
 """
 import math
+import os
 import random
+import sys
 
 import numpy
 import pytest
@@ -674,3 +676,19 @@ def test_wedge_with_fs_above_one_stands(scene, name):
     assert S.norm(S.sub(centroid(wedge), c0)) < 1e-4
     assert S.norm(rotation_vector(wedge)) < 1e-4
     assert normal_force_between(wedge, slabA) > 0 and normal_force_between(wedge, slabB) > 0
+
+
+def test_frictional_start_up_error_is_the_penalty_springs(scene):
+    """Why frictional slides get less accurate as dt shrinks (README, "What accuracy
+    costs"; bench/friction_startup.py). A rigid cube at rest on a 30 deg slope with
+    20 deg friction, its contacts preloaded with its weight: with a dt that does not
+    resolve the shear springs' period it slides exactly as Coulomb friction says (to
+    round-off); with dt = 1e-5 s it leaves its first, locked step too fast, by about
+    F / (m omega), omega = sqrt(4 ks / m), so a 10 times stiffer penalty cuts the
+    error by about sqrt(10)."""
+    sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..', '..', 'bench'))
+    from friction_startup import velocityError
+    assert abs(velocityError(1e-3, 40.0)) < 1e-12
+    resolved, stiffer = velocityError(1e-5, 40.0), velocityError(1e-5, 400.0)
+    assert resolved > 1e-5, resolved
+    assert 2.5 < resolved / stiffer < 4.5, (resolved, stiffer)
