@@ -4,7 +4,10 @@
   first step) raises and erases nothing: the core cannot remove a block from
   a running scene yet. Blocks not yet in the core (before the first step
   after their ``append``) may be erased. ``O.bodies.clear()`` also clears the
-  DDA state of the scene.
+  DDA state of the scene, and ``O.bodies.replace(bodies)`` clears it and
+  makes the DDA blocks among ``bodies`` the new scene's blocks (they enter
+  the core at the next step). Blocks made by ``ddaBlock()`` but not yet
+  appended stay appendable across both.
 - Blocks entering the scene overlapping deeper than the initial-overlap
   tolerance (dda/solver/InitialOverlaps.hpp) are refused with the two body
   ids and the depth; nothing is added and no step is taken.
@@ -27,6 +30,7 @@ _INTEGRATOR_COMMAND = 'import yade_dda.engines'
 
 _originalErase = wrapper.BodyContainer.erase
 _originalClear = wrapper.BodyContainer.clear
+_originalReplace = wrapper.BodyContainer.replace
 
 
 def _erase(self, id, *args, **kw):
@@ -42,23 +46,46 @@ def _erase(self, id, *args, **kw):
     return _originalErase(self, id, *args, **kw)
 
 
-def _clear(self, *args, **kw):
-    result = _originalClear(self, *args, **kw)
+def _freshScene(keep):
+    """Replaces the current DDA scene (its blocks are gone from O.bodies) by an
+    empty one that keeps the pending blocks for which keep(body) is true.
+    (O.tags has no __delitem__, so the token is replaced rather than removed.)"""
     old = _scene.current(create=False)
-    if old is not None:
-        # The blocks are gone: a fresh, empty DDA scene takes the place of the old one.
-        # (O.tags has no __delitem__, so the token is replaced rather than removed.)
-        token = uuid.uuid4().hex
-        _scene._scenes.pop(old.token, None)
-        _scene._scenes[token] = _scene.DDAScene(token)
-        O.tags[_scene.TAG] = token
+    if old is None:
+        return
+    token = uuid.uuid4().hex
+    fresh = _scene.DDAScene(token)
+    fresh.pending = [(body, spec) for body, spec in old.pending if keep(body)]
+    _scene._scenes.pop(old.token, None)
+    _scene._scenes[token] = fresh
+    O.tags[_scene.TAG] = token
+
+
+def _clear(self, *args, **kw):
+    old = _scene.current(create=False)
+    unappended = set() if old is None else {id(body) for body, _ in old.pending if body.id < 0}
+    result = _originalClear(self, *args, **kw)
+    _freshScene(lambda body: id(body) in unappended)
+    return result
+
+
+def _replace(self, bodies, *args, **kw):
+    bodies = list(bodies)
+    old = _scene.current(create=False)
+    keep = set() if old is None else {id(body) for body, _ in old.pending if body.id < 0}
+    keep.update(id(body) for body in bodies)
+    # YADE's replace clears the container in C++ (not through _clear) and appends bodies.
+    result = _originalReplace(self, bodies, *args, **kw)
+    _freshScene(lambda body: id(body) in keep)
     return result
 
 
 _erase.__doc__ = _originalErase.__doc__
 _clear.__doc__ = _originalClear.__doc__
+_replace.__doc__ = _originalReplace.__doc__
 wrapper.BodyContainer.erase = _erase
 wrapper.BodyContainer.clear = _clear
+wrapper.BodyContainer.replace = _replace
 
 
 # ------------------------------------------------------------------ initial overlaps

@@ -315,6 +315,34 @@ def test_clearing_the_bodies_also_clears_the_dda_state(scene):
     assert stats()['blocks'] == 1 and yade_dda.blockOf(b) == 0
 
 
+def test_replacing_the_bodies_replaces_the_dda_scene(scene):
+    """Documented: O.bodies.replace(bodies) starts a fresh DDA scene whose blocks are the DDA
+    blocks among bodies; they enter at the next step and fall from rest (before: YADE's
+    replace bypassed the clear guard and the next step failed with 'IndexError: Body id out
+    of range' in the sync, the core still holding the old blocks)."""
+    running()
+    ids = O.bodies.replace([ddaBlock(box((5, 5, 2), (6, 6, 3))), ddaBlock(box((5, 5, -1), (6, 6, 0)), fixed=True)])
+    assert list(ids) == [0, 1]
+    O.run(10, True)
+    assert stats()['blocks'] == 2 and stats()['movingBlocks'] == 1 and stats()['steps'] == 10
+    assert yade_dda.blockOf(0) == 0 and yade_dda.blockOf(1) == 1
+    t = 10 * 1e-3
+    assert abs(O.bodies[0].state.pos[2] - (2.5 - G * t * t / 2)) < 1e-9
+
+
+def test_a_block_made_before_clear_can_be_appended_after_it(scene):
+    """Documented: a ddaBlock() not yet appended survives O.bodies.clear() (before: the fresh
+    DDA scene forgot it, and once appended it was a YADE body the core never moved)."""
+    running()
+    made = ddaBlock(box((5, 5, 2), (6, 6, 3)))
+    O.bodies.clear()
+    b = O.bodies.append(made)
+    O.run(10, True)
+    assert stats()['blocks'] == 1 and yade_dda.blockOf(b) == 0
+    t = 10 * 1e-3
+    assert abs(O.bodies[b].state.pos[2] - (2.5 - G * t * t / 2)) < 1e-9
+
+
 def test_dda_block_added_mid_run_enters_at_the_next_step(scene):
     """Documented: a block appended mid-run enters the core at the next step and falls from rest."""
     floor, free = running()
