@@ -269,6 +269,7 @@ py::dict lastStep(const SceneLink& s) {
 	d["openCloseIterationsTotal"] = st.openCloseIterationsTotal;
 	d["stateChanges"] = st.stateChanges;
 	d["normalForceUpdates"] = st.normalForceUpdates;
+	d["openCloseHeld"] = st.openCloseHeld;
 	d["openCloseCuts"] = st.openCloseCuts;
 	d["openCloseFailures"] = st.openCloseFailures;
 	d["maxPenetration"] = st.maxPenetration;

@@ -76,6 +76,7 @@ struct Contact {
 	double tensileForce = 0;     // bond's tensile strength [N]
 	bool isNew = true;           // no history was found
 	int frictionSwitches = 0;    // sliding <-> locked switches in this step's open-close iteration
+	int openCloseSwitches = 0;   // open <-> closed changes in this step's open-close iteration
 	// Block i's contact point at the end of the step [m] (for reports).
 	Vector3 point = Vector3::Zero();
 };

@@ -103,6 +103,7 @@ struct StepStatistics {
 	int openCloseIterationsTotal = 0;  // solves in all attempts of the step
 	int stateChanges = 0;            // contact state changes in the accepted attempt
 	int normalForceUpdates = 0;      // solves made only because sliding contacts' normal forces had not settled (all attempts)
+	int openCloseHeld = 0;           // openings undone: a cycling contact held closed within its gap band (all attempts)
 	int openCloseCuts = 0;           // dt cuts because the iteration did not converge
 	long openCloseFailures = 0;      // steps accepted unconverged after maxStepCuts (cumulative)
 	double maxPenetration = 0;       // deepest closed contact at the end of the step [m]

@@ -33,6 +33,11 @@ constexpr double kCornerMergeFraction = 1e-3;
 constexpr double kMaxParallelAngleTolerance = 0.05;
 // Sliding/locked switches of one contact that keep an open-close iteration going (see step()).
 constexpr int kFrictionSwitchesCounted = 2;
+// Open/closed changes of one contact that keep an open-close iteration going,
+// and the gap band (fraction of the allowed step displacement) within which a
+// contact that keeps cycling is held closed (see step()).
+constexpr int kOpenCloseSwitchesCounted = 2;
+constexpr double kHoldClosedFraction = 1e-3;
 // Sliding contacts' normal forces have settled when a solve changes each by at
 // most this fraction of the largest normal force (the friction load lags N by
 // one solve); solves of a step that may be spent on settling them.
@@ -442,6 +447,7 @@ double World::step(const IntegratorSettings& settings) {
 	std::vector<Contact>& contacts = store_.contacts();
 
 	const double openTolerance = settings.openCloseTolerance * stats.allowedDisplacement;
+	const double holdClosedGap = std::max(openTolerance, kHoldClosedFraction * stats.allowedDisplacement);
 	double dt = nextTimeStep_ > 0 ? std::min(nextTimeStep_, settings.maxTimeStep) : settings.maxTimeStep;
 
 	for (int attempt = 0;; ++attempt) {
@@ -457,6 +463,7 @@ double World::step(const IntegratorSettings& settings) {
 		for (Contact& contact : contacts) {
 			startTrial(contact, steps_ == 0);
 			contact.frictionSwitches = 0;
+			contact.openCloseSwitches = 0;
 			const int bi = contact.key.blockI, bj = contact.key.blockJ;
 			startSlidingIfMoving(contact, blocks_[bi], blocks_[bj], ofBlock(startVelocities_, bi), ofBlock(startVelocities_, bj), dt);
 		}
@@ -490,6 +497,27 @@ double World::step(const IntegratorSettings& settings) {
 				const bool frictionSwitch =
 				    before.state != ContactState::Open && contact.trial.state != ContactState::Open;
 				if (!frictionSwitch) {
+					// A contact that has opened and closed again in this
+					// iteration and would open once more cycles: closed, the
+					// solve leaves it a hair apart (in tension); open, the
+					// corner falls in (a block rocking between two supports of
+					// a pile). Held closed when its gap is within
+					// kHoldClosedFraction of the allowed step displacement: the
+					// spring then holds a tension of at most kn x that gap for
+					// this one step, stores kn gap^2 / 2 and gives it back
+					// when it opens next step. Opened instead, the corner would
+					// sink up to a step's motion into the other block and be
+					// pushed out with the energy of that penetration; cutting
+					// dt (what the iteration did before) costs a redo and
+					// often cycled again at the smaller dt.
+					if (contact.trial.state == ContactState::Open && !before.bonded &&
+					    contact.openCloseSwitches >= kOpenCloseSwitchesCounted &&
+					    contactGap(contact, ofBlock(solutions_, bi), ofBlock(solutions_, bj)) <= holdClosedGap) {
+						contact.trial = before;
+						++stats.openCloseHeld;
+						continue;
+					}
+					++contact.openCloseSwitches;
 					// Opening and closing always count, and change which blocks
 					// the system couples (only closed contacts carry terms).
 					structureStale = true;
