@@ -692,3 +692,29 @@ def test_frictional_start_up_error_is_the_penalty_springs(scene):
     resolved, stiffer = velocityError(1e-5, 40.0), velocityError(1e-5, 400.0)
     assert resolved > 1e-5, resolved
     assert 2.5 < resolved / stiffer < 4.5, (resolved, stiffer)
+
+
+@pytest.mark.parametrize('small', [1e-2, 1e-3, 1e-4])
+def test_tiny_block_resting_on_a_huge_one(scene, small):
+    """Scales over up to five decades coupled by closed contacts: a cube of side `small`
+    [m] dropped onto a free 10 m block standing on a fixed floor. The two moving blocks
+    form one system whose 12x12 blocks differ by (10 / small)^5 in mass; its Cholesky
+    factorisation must not fail (it did, on the fuzzer's mixed-scale scenes, while open
+    contacts still joined blocks into one system), and the cube must come to rest on
+    the big block's top face: no NaN, no sinking beyond the penalty tolerance, not
+    thrown off."""
+    floor = S.add_block(S.box((-20, -20, -1), (20, 20, 0)), S.rock(30.0), fixed=True)
+    big = S.add_block(S.box((-5, -5, 0), (5, 5, 10)), S.rock(30.0))
+    cube = S.add_block(S.box((0, 0, 10 + small / 10), (small, small, 10 + small + small / 10)), S.rock(30.0))
+    O.engines = [DDAIntegrator(dt=1e-3, gravity=(0, 0, -G))]
+    O.run(200, True)
+    s = yade_dda.stats()
+    assert s['largestComponent'] == 2 and s['closedContacts'] >= 8
+    top = max(v[2] for v in yade_dda.block(big).vertices)
+    bottom = min(v[2] for v in yade_dda.block(cube).vertices)
+    weight = S.ROCK['density'] * small ** 3 * G
+    kn = 40 * S.ROCK['young'] * small   # contactPenaltyFactor x E x the smaller size
+    assert -2 * weight / kn - 1e-9 * 10 <= bottom - top <= 1e-9 * 10, (bottom - top, weight / kn)
+    c = yade_dda.block(cube).centroid
+    assert abs(c[0] - small / 2) < 1e-3 * small and abs(c[1] - small / 2) < 1e-3 * small, c   # not thrown off
+    assert all(math.isfinite(x) for x in yade_dda.block(cube).velocity)
