@@ -176,12 +176,9 @@ py::object detectPair(const SceneLink& s, int a, int b, double d0) {
 	if (a == b) throw InputError("a block cannot contact itself");
 	const Block& A = s.world.block(a);
 	const Block& B = s.world.block(b);
-	Eigen::AlignedBox3d box;
-	for (const Vector3& x : A.vertices) box.extend(x);
-	for (const Vector3& x : B.vertices) box.extend(x);
-	DetectionSettings settings;
-	settings.contactDistance = d0;
-	settings.lengthTolerance = kDefaultRelativeLengthTolerance * box.diagonal().norm();
+	// The integrator's settings for this pair (its last step's allowed displacement).
+	const DetectionSettings settings =
+	    pairDetectionSettings(boundingDiagonal(A), boundingDiagonal(B), d0, s.world.lastStep().allowedDisplacement);
 	const auto result = detectPairContacts(BlockGeometry{A.shape.get(), &A.vertices, A.centroid},
 	                                       BlockGeometry{B.shape.get(), &B.vertices, B.centroid}, settings);
 	if (!result) return py::object();

@@ -1,5 +1,5 @@
-// Scene builders shared by the broad-phase tests (test_colliders.cpp,
-// test_msc.cpp): oriented boxes and a random scene of slender and compact,
+// Scene builders shared by the C++ tests (test_colliders.cpp, test_msc.cpp,
+// test_block_kinematics.cpp, ...): axis-aligned and oriented boxes and a random scene of slender and compact,
 // turned, fixed and free blocks with a few exact placements; and the contact
 // set a broad phase plus the narrow phase find.
 #pragma once
@@ -19,6 +19,14 @@
 #include <vector>
 
 namespace dda::testing {
+
+// Corners of the axis-aligned box [lo, hi] [m].
+inline std::vector<Vector3> boxPoints(const Vector3& lo, const Vector3& hi) {
+	std::vector<Vector3> p;
+	for (int i = 0; i < 8; ++i)
+		p.emplace_back(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(), i & 4 ? hi.z() : lo.z());
+	return p;
+}
 
 inline std::vector<Vector3> orientedBox(const Vector3& centre, const Vector3& half, const Eigen::Matrix3d& R) {
 	std::vector<Vector3> points;

@@ -2,6 +2,7 @@
 // matrices, and one implicit step of a free block, against closed forms.
 #include "dda/block/Displacement.hpp"
 #include "dda/solver/World.hpp"
+#include "TestScenes.hpp"
 
 #include <gtest/gtest.h>
 
@@ -9,6 +10,7 @@
 #include <random>
 
 using namespace dda;
+using dda::testing::boxPoints;
 
 namespace {
 Vector12 randomUnknowns(std::mt19937& rng) {
@@ -18,12 +20,6 @@ Vector12 randomUnknowns(std::mt19937& rng) {
 	return D;
 }
 
-std::vector<Vector3> boxPoints(const Vector3& lo, const Vector3& hi) {
-	std::vector<Vector3> p;
-	for (int i = 0; i < 8; ++i)
-		p.emplace_back(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(), i & 4 ? hi.z() : lo.z());
-	return p;
-}
 }  // namespace
 
 TEST(BlockKinematics, DisplacementMatrixMatchesFieldAndEquation3) {

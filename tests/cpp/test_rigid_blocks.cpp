@@ -4,6 +4,7 @@
 #include "dda/block/Displacement.hpp"
 #include "dda/solver/CoupledSystem.hpp"
 #include "dda/solver/World.hpp"
+#include "TestScenes.hpp"
 
 #include <gtest/gtest.h>
 
@@ -11,15 +12,7 @@
 #include <random>
 
 using namespace dda;
-
-namespace {
-std::vector<Vector3> boxPoints(const Vector3& lo, const Vector3& hi) {
-	std::vector<Vector3> p;
-	for (int i = 0; i < 8; ++i)
-		p.emplace_back(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(), i & 4 ? hi.z() : lo.z());
-	return p;
-}
-}  // namespace
+using dda::testing::boxPoints;
 
 TEST(RigidBlocks, RigidMassMatrixIsTheTranslationRotationBlockOfTheMassMatrix) {
 	std::mt19937 rng(11);

@@ -466,15 +466,9 @@ void fuzzPair(Recipe& in) {
 	}
 	const Block& A = world.block(0);
 	const Block& B = world.block(1);
-	Eigen::AlignedBox3d box;
-	for (const Vector3& x : A.vertices) box.extend(x);
-	for (const Vector3& x : B.vertices) box.extend(x);
-	DetectionSettings settings;
-	settings.contactDistance = d0;
-	settings.lengthTolerance = kDefaultRelativeLengthTolerance * box.diagonal().norm();
-	settings.hysteresis = std::max(0.1 * d0, settings.lengthTolerance);
-	settings.cornerMergeDistance = 1e-3 * std::min(sizeA, sizeB);
-	settings.angleTolerance = in.coin() ? kDefaultParallelAngleTolerance : 0.05;
+	// The integrator's settings, at the smallest or the largest parallel-edge angle.
+	DetectionSettings settings = pairDetectionSettings(boundingDiagonal(A), boundingDiagonal(B), d0, 0.0);
+	if (in.coin()) settings.angleTolerance = 0.05;
 	const BlockGeometry ga{A.shape.get(), &A.vertices, A.centroid};
 	const BlockGeometry gb{B.shape.get(), &B.vertices, B.centroid};
 	EntranceFeature previous;

@@ -88,19 +88,26 @@ def test_save_load_continue_is_bitwise(scene, reference, tmp_path, form):
     _compare(saveload_scene.state(), reference[1])
 
 
+def _continueAcrossSaveLoad(tmp_path, runOn, **build):
+    """Runs N + M steps of saveload_scene.build(**build) uninterrupted, then N,
+    save, runOn more, load, M; returns the uninterrupted final state."""
+    saveload_scene.build(**build)
+    O.run(N + M, True)
+    want = saveload_scene.state()
+    saveload_scene.build(**build)
+    O.run(N, True)
+    O.save(str(tmp_path / 'scene.yade'))
+    O.run(runOn, True)
+    O.load(str(tmp_path / 'scene.yade'))
+    return want
+
+
 @pytest.mark.parametrize('collider', ['DESS', 'NBS', 'AllPairs'])
 def test_save_load_continue_is_bitwise_with_each_collider(scene, tmp_path, collider):
     """The other strategies keep caches (DESS's candidate pairs, within Verlet
     boxes) that are not saved but rebuilt: the continuation must still be
     bitwise that of an uninterrupted run."""
-    saveload_scene.build(collider=collider)
-    O.run(N + M, True)
-    want = saveload_scene.state()
-    saveload_scene.build(collider=collider)
-    O.run(N, True)
-    O.save(str(tmp_path / 'scene.yade'))
-    O.run(11, True)
-    O.load(str(tmp_path / 'scene.yade'))
+    want = _continueAcrossSaveLoad(tmp_path, 11, collider=collider)
     O.run(M, True)
     _compare(saveload_scene.state(), want)
 
@@ -108,14 +115,7 @@ def test_save_load_continue_is_bitwise_with_each_collider(scene, tmp_path, colli
 def test_rigid_block_stays_rigid_across_save_load(scene, tmp_path):
     """A rigid block's flag is part of the saved state: loaded, it keeps 6
     unknowns and no strain, and the run continues bitwise."""
-    saveload_scene.build(rigidTop=True)
-    O.run(N + M, True)
-    want = saveload_scene.state()
-    saveload_scene.build(rigidTop=True)
-    O.run(N, True)
-    O.save(str(tmp_path / 'rigid.yade'))
-    O.run(7, True)
-    O.load(str(tmp_path / 'rigid.yade'))
+    want = _continueAcrossSaveLoad(tmp_path, 7, rigidTop=True)
     assert yade_dda.block(O.bodies[4]).rigid and not yade_dda.block(O.bodies[3]).rigid
     O.run(M, True)
     assert yade_dda.stats()['rigidBlocks'] == 1

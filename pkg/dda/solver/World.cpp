@@ -147,6 +147,28 @@ double projectedHullArea(const std::vector<Vector3>& points, const Vector3& norm
 }
 }  // namespace
 
+double boundingDiagonal(const Block& block) {
+	Eigen::AlignedBox3d box;
+	for (const Vector3& x : block.vertices) box.extend(x);
+	return box.diagonal().norm();
+}
+
+DetectionSettings pairDetectionSettings(double diagonalA, double diagonalB, double contactDistance,
+                                        double allowedDisplacement) {
+	DetectionSettings detection;
+	detection.contactDistance = contactDistance;
+	detection.lengthTolerance = kDefaultRelativeLengthTolerance * std::max(diagonalA, diagonalB);
+	detection.hysteresis = std::max(kEntranceHysteresis * contactDistance, detection.lengthTolerance);
+	detection.cornerMergeDistance = kCornerMergeFraction * std::min(diagonalA, diagonalB);
+	// Edges closer to parallel than a block can turn in one step have no
+	// stable crossing point: their contact is the vertex contacts at their
+	// ends. The turn per step is at most the allowed displacement over the
+	// half diagonal.
+	detection.angleTolerance = std::clamp(2 * allowedDisplacement / std::min(diagonalA, diagonalB),
+	                                      kDefaultParallelAngleTolerance, kMaxParallelAngleTolerance);
+	return detection;
+}
+
 int World::addBlock(const std::vector<Vector3>& points, const Material& material, bool fixed, bool rigid) {
 	blocks_.push_back(makeBlock(points, material, fixed, rigid));
 	return blockCount() - 1;
@@ -308,28 +330,14 @@ void World::detectContacts(const IntegratorSettings& settings, StepStatistics& s
 	pairWork_.assign(pairCount, NarrowPhaseWork{});
 	std::vector<double>& diagonal = diagonals_;
 	diagonal.resize(blocks_.size());
-	for (std::size_t b = 0; b < blocks_.size(); ++b) {
-		Eigen::AlignedBox3d box;
-		for (const Vector3& x : blocks_[b].vertices) box.extend(x);
-		diagonal[b] = box.diagonal().norm();
-	}
+	for (std::size_t b = 0; b < blocks_.size(); ++b) diagonal[b] = boundingDiagonal(blocks_[b]);
 #pragma omp parallel for schedule(dynamic, 16) if (pairCount >= kMinBlocksForThreads)
 	for (int p = 0; p < pairCount; ++p) {
 		const auto [a, b] = pairs_[p];
 		const Block& A = blocks_[a];
 		const Block& B = blocks_[b];
-		DetectionSettings detection;
-		detection.contactDistance = stats.contactDistance;
-		detection.lengthTolerance = kDefaultRelativeLengthTolerance * std::max(diagonal[a], diagonal[b]);
-		detection.hysteresis = std::max(kEntranceHysteresis * stats.contactDistance, detection.lengthTolerance);
-		detection.cornerMergeDistance = kCornerMergeFraction * std::min(diagonal[a], diagonal[b]);
-		// Edges closer to parallel than a block can turn in one step have no
-		// stable crossing point: their contact is the vertex contacts at their
-		// ends. The turn per step is at most the allowed displacement over the
-		// half diagonal.
-		detection.angleTolerance = std::clamp(
-		    2 * stats.allowedDisplacement / std::min(diagonal[a], diagonal[b]), kDefaultParallelAngleTolerance,
-		    kMaxParallelAngleTolerance);
+		const DetectionSettings detection =
+		    pairDetectionSettings(diagonal[a], diagonal[b], stats.contactDistance, stats.allowedDisplacement);
 		const std::vector<char>* internalA = internalFaces_[a].empty() ? nullptr : &internalFaces_[a];
 		const std::vector<char>* internalB = internalFaces_[b].empty() ? nullptr : &internalFaces_[b];
 		pairResults_[p] = detectPairContacts(BlockGeometry{A.shape.get(), &A.vertices, A.centroid, internalA},

@@ -22,6 +22,17 @@ class StateReader;
 // (throws InputError naming the problem). World::addBlock adds one.
 Block makeBlock(const std::vector<Vector3>& points, const Material& material, bool fixed, bool rigid = false);
 
+// Diagonal of a block's bounding box [m].
+double boundingDiagonal(const Block& block);
+
+// The narrow phase's settings for a pair of blocks of bounding diagonals
+// diagonalA and diagonalB [m], as World::step uses them: contact distance d0
+// [m], length tolerance, entrance hysteresis and corner merge distance from the
+// blocks' sizes, and the parallel-edge angle from the allowed step
+// displacement [m] (0: the smallest angle tolerance).
+DetectionSettings pairDetectionSettings(double diagonalA, double diagonalB, double contactDistance,
+                                        double allowedDisplacement);
+
 class World {
 public:
 	// Builds and validates a block (throws InputError; the world is unchanged then).
