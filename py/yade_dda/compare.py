@@ -77,7 +77,8 @@ def _runOurs(name, blockList, steps, dt, gravity, mat, threads, integrator):
     for points, fixed in blockList:
         O.bodies.append(ddaBlock(points, material=material, fixed=fixed))
     params = dict(integrator)
-    params.update(dt=dt, gravity=tuple(gravity), threads=threads)
+    # Every strategy searches every step (DESS's candidate-pair cache, an effect on demand, is off).
+    params.update(dt=dt, gravity=tuple(gravity), threads=threads, reuseCandidatePairs=False)
     O.engines = [_colliders.ENGINES[name](label='collider'), DDAIntegrator(label='dda', **params)]
     perStep = {key: [] for key in ('candidatePairs', 'contactPairs', 'contacts', 'broadMs', 'narrowMs',
                                    'detectionMs', 'dt')}
