@@ -183,8 +183,11 @@ def run_tests(src, tree, nodeids, xml, log, timeout):
 
 
 def first_line(message, width=None):
-    line = message.strip().splitlines()[0] if message.strip() else ''
-    line = re.sub(r'^AssertionError: ', '', line)
+    """The assertion's first line, with pytest's `assert ...` line after a custom message."""
+    lines = message.strip().splitlines() or ['']
+    line = re.sub(r'^AssertionError: ', '', lines[0])
+    if len(lines) > 1 and lines[1].startswith('assert ') and not line.startswith('assert '):
+        line += ' / ' + lines[1]
     return line if width is None or len(line) <= width else line[:width - 3] + '...'
 
 
