@@ -262,13 +262,15 @@ def main():
         json.dump(report, f, indent=1)
 
     print()
-    print('%-22s %-46s %-8s %-6s %s' % ('mutation', 'removes', 'failed', 'caught', 'first assertion message'))
+    rows = [('mutation', 'removes', 'failed', 'caught', 'first failing test: assertion message')]
     for r in report['mutations']:
-        print('%-22s %-46s %-8s %-6s %s' % (r['name'], first_line(r['removes'], 46),
-                                            '%d/%d' % (len(r['caughtBy']), len(r['tests'])),
-                                            'yes' if r['caught'] else 'NO',
-                                            (short_test(r['caughtBy'][0]) + ': ' + first_line(r['message'], 110))
-                                            if r['caught'] else ''))
+        rows.append((r['name'], r['removes'], '%d/%d' % (len(r['caughtBy']), len(r['tests'])),
+                     'yes' if r['caught'] else 'NO',
+                     short_test(r['caughtBy'][0]) + ': ' + first_line(r['message'], 110) if r['caught'] else
+                     '; '.join('%s %s' % (short_test(t), x['outcome']) for t, x in r['tests'].items())))
+    widths = [max(len(row[k]) for row in rows) for k in range(4)]
+    for row in rows:
+        print('  '.join(c.ljust(w) for c, w in zip(row, widths)) + '  ' + row[4])
     print('\nbaseline %s; %d of %d mutations caught; %.0f s; report %s' % (
         'passed' if not bad else 'FAILED', sum(r['caught'] for r in report['mutations']), len(chosen),
         report['seconds'], args.out))
