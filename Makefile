@@ -8,7 +8,7 @@ DEB_PACKAGES := yade cmake g++ make libeigen3-dev libcgal-dev libgmp-dev libmpfr
                 libgtest-dev
 SITE_DIR := $(shell $(PYTHON) -c "import sysconfig;print(sysconfig.get_path('purelib','posix_local'))" 2>/dev/null)
 
-.PHONY: deps build install demo test test-hard test-cpp test-py bench regress regress-quick regress-run fuzz clean
+.PHONY: deps build install demo test test-hard test-cpp test-py bench regress regress-quick regress-run fuzz mutations clean
 
 deps:
 	@missing=$$(for p in $(DEB_PACKAGES); do dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null | grep -q 'install ok installed' || echo $$p; done); \
@@ -84,5 +84,14 @@ fuzz: deps
 	ASAN_OPTIONS=detect_leaks=0 $(FUZZ_BUILD)/fuzz_kernels_driver --seconds $(FUZZ_SECONDS) --seed $$(date +%s) \
 	    --crash-dir $(FUZZ_BUILD)/crashes tests/fuzz/corpus
 
+# Mutation checks of the hard-case suite (README, "Mutation checks"): each patch in tests/mutations
+# removes one core protection; run.py builds the module for the unmutated tree, then for each patch,
+# in one incremental build tree ($(MUTATION_BUILD)), and runs the tests the patch names: the
+# unmutated tree must pass them and each mutation must make one fail. Long (a build per mutation),
+# so not part of `test`. MUTATION_ARGS go to run.py (e.g. --only wedge-fs-1).
+MUTATION_BUILD := build-mutations
+mutations: deps
+	$(PYTHON) tests/mutations/run.py --build-dir $(MUTATION_BUILD) --jobs $(JOBS) $(MUTATION_ARGS)
+
 clean:
-	rm -rf $(BUILD) $(FUZZ_BUILD)
+	rm -rf $(BUILD) $(FUZZ_BUILD) $(MUTATION_BUILD)

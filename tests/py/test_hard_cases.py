@@ -293,33 +293,41 @@ def test_coplanar_face_on_face_stack(scene, kind):
 
 # ================================================================ slender blocks, stiffness contrast
 
-SLENDER = ['lengthwise', 'crosswise', 'incline']
+SLENDER = ['lengthwise', 'crosswise', 'crosswise-friction30', 'incline']
 
 
 @pytest.mark.parametrize('motion', SLENDER)
 def test_slender_block_sliding(scene, motion):
     """A 60:1 block (6 m x 0.1 m x 0.1 m) sliding: along its length and across it at 2 m/s on a
-    frictionless floor, and down a 30 deg incline with 20 deg of friction, 0.5 s.
+    frictionless floor, across it at 2 m/s on a floor with 30 deg of friction, and down a 30 deg
+    incline with 20 deg of friction, 0.5 s.
 
     What could go wrong: the block's contact edges are 60 times its size
     (size = cube root of volume, what the penalty and tolerances scale
     with), so a tolerance in units of the size misses contacts along the
     length; the small inertia about the long axis turns a one-sided
-    contact force into a fast roll; a linearised gap over a 6 m lever
-    penetrates. On the floor the block must keep its velocity (to 1e-6 m/s
-    and 1e-6 rad/s: nothing resists); on the incline it must follow
+    contact force into a fast roll (launched across a frictional floor, its
+    new corner contacts must slide from the first step: held locked for a
+    step, they tip the block over its long edge); a linearised gap over a
+    6 m lever penetrates. On the frictionless floor the block must keep its
+    velocity (to 1e-6 m/s and 1e-6 rad/s: nothing resists); on the
+    frictional one it must stop after v^2 / (2 g tan(phi)) within 1% (it
+    stops at 0.35 s); on the incline it must follow
     g (sin a - tan(phi) cos a) t^2 / 2 within 1%; it must stay flat (turned
     by less than 1e-4 rad; friction at the base pitches a block on an
     incline by the spring compliance only, 5e-8 rad here).
     """
+    speed = 2.0
+    friction = 30.0 if motion == 'crosswise-friction30' else 0.0
+
     def build():
         if motion == 'incline':
             geo, slab, block = S.build_incline(math.radians(30), (6.0, 0.1, 0.1), 20.0,
                                                slab=((-1.0, -1.5, -1.0), (12.0, 1.5, 0.0)))
             return block, geo
-        floor(0.0, size=(-2, -2, 20, 20))
-        block = S.add_block(S.box((0, 1, 0), (6, 1.1, 0.1)), rock(0))
-        O.bodies[block].state.vel = (2, 0, 0) if motion == 'lengthwise' else (0, 2, 0)
+        floor(0.0, size=(-2, -2, 20, 20), frictionDeg=friction)
+        block = S.add_block(S.box((0, 1, 0), (6, 1.1, 0.1)), rock(friction))
+        O.bodies[block].state.vel = (speed, 0, 0) if motion == 'lengthwise' else (0, speed, 0)
         return block, None
 
     guard, (block, geo) = run_case(build, 500)
@@ -329,8 +337,13 @@ def test_slender_block_sliding(scene, motion):
         slid = S.dot(S.sub(centroid(block), c0), geo['frame'][0])
         expected = S.incline_slide_distance(math.radians(30), math.radians(20), O.time)
         assert abs(slid - expected) < 0.01 * expected
+    elif friction:
+        slid = centroid(block)[1] - 1.05
+        expected = speed ** 2 / (2 * G * math.tan(math.radians(friction)))
+        assert speed / (G * math.tan(math.radians(friction))) < O.time   # the run outlasts the slide
+        assert abs(slid - expected) < 0.01 * expected, (slid, expected)
     else:
-        expected = (2, 0, 0) if motion == 'lengthwise' else (0, 2, 0)
+        expected = (speed, 0, 0) if motion == 'lengthwise' else (0, speed, 0)
         assert S.norm(S.sub(v[:3], expected)) < 1e-6
         assert S.norm(v[3:6]) < 1e-6
     assert yade_dda.block(block).rotation.toRotationVector().norm() < 1e-4

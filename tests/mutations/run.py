@@ -1,0 +1,282 @@
+"""Mutation checks of the hard-case suite (issue 5): each case class fails
+when the core mechanism that guards it is removed.
+
+Every `*.patch` in this directory is one mutation: a unified diff against the
+current sources that removes one protection, after a header of `Key: value`
+lines (continuation lines indented) that git apply skips:
+
+    Removes:    the mechanism, in a few words (the table's column)
+    Mechanism:  where it is and what it does
+    Tests:      the pytest node ids that must fail without it
+    Why:        why those tests fail without it
+
+The name of a mutation is its file name without the leading number and
+`.patch` (the number orders the run). For the unmutated tree first, then for
+each mutation, the tracked and untracked (not ignored) files of this checkout
+are synchronised into <build-dir>/src (a file is rewritten only when its
+content differs, so the one build tree <build-dir>/build recompiles only what
+a mutation changed, and what the previous one changed back), the patch is
+applied with `git apply`, the Python module is built, and the named tests run
+against it (YADE_DDA_BUILD=<build-dir>/build/py, slow cases included). The
+unmutated tree must pass every named test; a mutation is caught when at least
+one of its tests fails (a crashed test run counts as a failure, a timeout or a
+skip does not).
+
+Writes a JSON report (bench/out/mutations.json unless --out), prints a table
+and exits non-zero when the baseline fails or a mutation is not caught.
+
+Run: /usr/bin/python3 tests/mutations/run.py [--only NAME ...] [--build-dir DIR]
+(`make mutations`). Not part of `make test`: it builds the module once per
+mutation.
+"""
+import argparse
+import filecmp
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import time
+import xml.etree.ElementTree as ET
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+REPO = os.path.dirname(os.path.dirname(HERE))
+PYTHON = '/usr/bin/python3'
+KEEP_IN_SOURCE_COPY = {'__pycache__', '.pytest_cache'}
+
+
+# ---------------------------------------------------------------- mutations
+
+def read_mutation(path):
+    """The header fields of a patch file (lower-case keys) plus name and path."""
+    fields, key = {}, None
+    with open(path) as f:
+        for line in f:
+            if line.startswith(('diff --git', '--- ')):
+                break
+            if key and line[:1] in (' ', '\t') and line.strip():
+                fields[key] += ' ' + line.strip()
+                continue
+            m = re.match(r'([A-Za-z]+):\s*(.*)$', line.rstrip('\n'))
+            key = m.group(1).lower() if m else None
+            if key:
+                fields[key] = m.group(2).strip()
+    name = re.sub(r'^\d+-', '', os.path.basename(path)[:-len('.patch')])
+    missing = [k for k in ('removes', 'mechanism', 'tests', 'why') if not fields.get(k)]
+    if missing:
+        raise SystemExit('%s: header lacks %s' % (path, ', '.join(missing)))
+    return dict(name=name, path=path, removes=fields['removes'], mechanism=fields['mechanism'],
+                tests=fields['tests'].split(), why=fields['why'])
+
+
+def mutations():
+    return [read_mutation(os.path.join(HERE, f)) for f in sorted(os.listdir(HERE)) if f.endswith('.patch')]
+
+
+# ---------------------------------------------------------------- source copy and build
+
+def git(*args, cwd=REPO, env=None):
+    return subprocess.run(('git',) + args, cwd=cwd, env=env, check=True, stdout=subprocess.PIPE,
+                          stderr=subprocess.PIPE, text=True).stdout
+
+
+def sync_sources(src):
+    """Makes `src` hold exactly this checkout's tracked and untracked, not ignored,
+    files, rewriting only those whose content differs (their mtimes drive the build)."""
+    listed = [p for p in git('ls-files', '-z', '--cached', '--others', '--exclude-standard').split('\0') if p]
+    wanted = set()
+    for rel in listed:
+        origin = os.path.join(REPO, rel)
+        if not os.path.isfile(origin):
+            continue   # deleted in the checkout, not yet in the index
+        wanted.add(rel)
+        target = os.path.join(src, rel)
+        if os.path.isfile(target) and filecmp.cmp(origin, target, shallow=False):
+            continue
+        os.makedirs(os.path.dirname(target), exist_ok=True)
+        shutil.copy2(origin, target)
+        os.utime(target)   # newer than any object built from the old content
+    for root, dirs, files in os.walk(src):
+        dirs[:] = [d for d in dirs if d not in KEEP_IN_SOURCE_COPY]
+        for f in files:
+            rel = os.path.relpath(os.path.join(root, f), src)
+            if rel not in wanted:
+                os.remove(os.path.join(root, f))
+
+
+def apply_patch(src, patch):
+    """git apply in `src`, which lies in no repository (GIT_CEILING_DIRECTORIES
+    stops git from finding this checkout's repository above it)."""
+    env = dict(os.environ, GIT_CEILING_DIRECTORIES=os.path.dirname(os.path.abspath(src)))
+    for check in (True, False):
+        args = ['apply', '--check', patch] if check else ['apply', patch]
+        try:
+            git(*args, cwd=src, env=env)
+        except subprocess.CalledProcessError as e:
+            raise SystemExit('%s does not apply to the current sources:\n%s' % (patch, e.stderr))
+
+
+def build(src, tree, jobs, log):
+    if not os.path.exists(os.path.join(tree, 'CMakeCache.txt')):
+        run_logged(['cmake', '-S', src, '-B', tree, '-DCMAKE_BUILD_TYPE=Release', '-DPYTHON_EXECUTABLE=' + PYTHON,
+                    '-DPython3_EXECUTABLE=' + PYTHON], log)
+    run_logged(['cmake', '--build', tree, '-j', str(jobs), '--target', '_core', 'yade_dda_py'], log)
+
+
+def run_logged(cmd, log):
+    with open(log, 'a') as out:
+        out.write('$ %s\n' % ' '.join(cmd))
+        out.flush()
+        code = subprocess.call(cmd, stdout=out, stderr=subprocess.STDOUT)
+    if code != 0:
+        raise SystemExit('%s failed (exit %d), see %s' % (cmd[0] + ' ' + cmd[1], code, log))
+
+
+# ---------------------------------------------------------------- tests
+
+def junit_key(nodeid):
+    """(classname, name) pytest's junit XML gives a test function's node id."""
+    path, _, name = nodeid.partition('::')
+    return path[:-len('.py')].replace('/', '.'), name
+
+
+def run_tests(src, tree, nodeids, xml, log, timeout):
+    """{node id: {outcome: passed|failed|crashed|skipped|timeout|not run, message}}."""
+    if os.path.exists(xml):
+        os.remove(xml)
+    cmd = [PYTHON, '-m', 'pytest', '-q', '-p', 'no:cacheprovider', '-m', 'slow or not slow', '--junitxml=' + xml] \
+        + list(nodeids)
+    env = dict(os.environ, YADE_DDA_BUILD=os.path.join(tree, 'py'), PYTHONDONTWRITEBYTECODE='1')
+    with open(log, 'a') as out:
+        out.write('$ YADE_DDA_BUILD=%s %s\n' % (env['YADE_DDA_BUILD'], ' '.join(cmd)))
+        out.flush()
+        try:
+            code = subprocess.call(cmd, cwd=src, env=env, stdout=out, stderr=subprocess.STDOUT, timeout=timeout)
+        except subprocess.TimeoutExpired:
+            code = None
+    results = {}
+    if os.path.exists(xml):
+        for case in ET.parse(xml).getroot().iter('testcase'):
+            key = (case.get('classname'), case.get('name'))
+            outcome, message = 'passed', ''
+            for child in case:
+                if child.tag in ('failure', 'error'):
+                    outcome = 'failed'
+                    message = (child.get('message') or child.text or '').strip()
+                    break
+                if child.tag == 'skipped':
+                    outcome, message = 'skipped', (child.get('message') or '').strip()
+            results[key] = dict(outcome=outcome, message=message)
+    out = {}
+    for nodeid in nodeids:
+        r = results.get(junit_key(nodeid))
+        if r is None:
+            if code is None:
+                r = dict(outcome='timeout', message='no result within %d s' % timeout)
+            elif code < 0:
+                r = dict(outcome='crashed', message='the test process died with signal %d' % -code)
+            else:
+                r = dict(outcome='not run', message='pytest ran no such test (exit %d)' % code)
+        out[nodeid] = r
+    return out
+
+
+def first_line(message, width=None):
+    """The assertion's first line, with pytest's `assert ...` line after a custom message."""
+    lines = message.strip().splitlines() or ['']
+    line = re.sub(r'^AssertionError: ', '', lines[0])
+    if len(lines) > 1 and lines[1].startswith('assert ') and not line.startswith('assert '):
+        line += ' / ' + lines[1]
+    return line if width is None or len(line) <= width else line[:width - 3] + '...'
+
+
+def short_test(nodeid):
+    return nodeid.split('::', 1)[-1]
+
+
+# ---------------------------------------------------------------- main
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--only', action='append', metavar='NAME', help='run this mutation only (repeatable)')
+    parser.add_argument('--build-dir', default=os.path.join(REPO, 'build-mutations'),
+                        help='source copy, build tree and logs (default build-mutations/)')
+    parser.add_argument('--out', default=os.path.join(REPO, 'bench', 'out', 'mutations.json'))
+    parser.add_argument('--jobs', type=int, default=int(os.environ.get('JOBS', 2)))
+    parser.add_argument('--timeout', type=int, default=3600, help='seconds per pytest run')
+    args = parser.parse_args()
+
+    chosen = mutations()
+    if args.only:
+        unknown = set(args.only) - {m['name'] for m in chosen}
+        if unknown:
+            raise SystemExit('no mutation named %s (have: %s)' % (', '.join(sorted(unknown)),
+                                                                  ', '.join(m['name'] for m in chosen)))
+        chosen = [m for m in chosen if m['name'] in args.only]
+    top = os.path.abspath(args.build_dir)
+    src, tree, logs = (os.path.join(top, d) for d in ('src', 'build', 'logs'))
+    for d in (src, tree, logs):
+        os.makedirs(d, exist_ok=True)
+    started = time.time()
+    head = git('rev-parse', 'HEAD').strip()
+    dirty = bool(git('status', '--porcelain', '--untracked-files=no').strip())
+
+    def stage(name, patch, nodeids):
+        log = os.path.join(logs, name + '.log')
+        open(log, 'w').close()
+        t0 = time.time()
+        sync_sources(src)
+        if patch:
+            apply_patch(src, patch)
+        build(src, tree, args.jobs, log)
+        t1 = time.time()
+        results = run_tests(src, tree, nodeids, os.path.join(logs, name + '.xml'), log, args.timeout)
+        t2 = time.time()
+        print('  %s: built in %.0f s, tests in %.0f s (log %s)' % (name, t1 - t0, t2 - t1, log), flush=True)
+        return results, dict(buildSeconds=round(t1 - t0, 1), testSeconds=round(t2 - t1, 1), log=log)
+
+    nodeids = sorted({t for m in chosen for t in m['tests']})
+    print('baseline: the unmutated tree, %d tests' % len(nodeids), flush=True)
+    results, timing = stage('baseline', None, nodeids)
+    bad = {t: r for t, r in results.items() if r['outcome'] != 'passed'}
+    report = dict(commit=head, dirty=dirty, baseline=dict(tests=results, passed=not bad, **timing), mutations=[])
+    for t, r in bad.items():
+        print('  baseline %s: %s %s' % (t, r['outcome'], first_line(r['message'])))
+
+    if not bad:
+        for m in chosen:
+            print('%s: %s' % (m['name'], m['removes']), flush=True)
+            results, timing = stage(m['name'], m['path'], m['tests'])
+            failed = [t for t in m['tests'] if results[t]['outcome'] in ('failed', 'crashed')]
+            report['mutations'].append(dict(
+                name=m['name'], patch=os.path.relpath(m['path'], REPO), removes=m['removes'],
+                mechanism=m['mechanism'], why=m['why'], tests=results, caught=bool(failed),
+                caughtBy=failed, message=results[failed[0]]['message'] if failed else '', **timing))
+        # leave the source copy unmutated
+        sync_sources(src)
+    report['seconds'] = round(time.time() - started, 1)
+
+    os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
+    with open(args.out, 'w') as f:
+        json.dump(report, f, indent=1)
+
+    print()
+    rows = [('mutation', 'removes', 'failed', 'caught', 'first failing test: assertion message')]
+    for r in report['mutations']:
+        rows.append((r['name'], r['removes'], '%d/%d' % (len(r['caughtBy']), len(r['tests'])),
+                     'yes' if r['caught'] else 'NO',
+                     short_test(r['caughtBy'][0]) + ': ' + first_line(r['message'], 110) if r['caught'] else
+                     '; '.join('%s %s' % (short_test(t), x['outcome']) for t, x in r['tests'].items())))
+    widths = [max(len(row[k]) for row in rows) for k in range(4)]
+    for row in rows:
+        print('  '.join(c.ljust(w) for c, w in zip(row, widths)) + '  ' + row[4])
+    print('\nbaseline %s; %d of %d mutations caught; %.0f s; report %s' % (
+        'passed' if not bad else 'FAILED', sum(r['caught'] for r in report['mutations']), len(chosen),
+        report['seconds'], args.out))
+    if bad or not all(r['caught'] for r in report['mutations']):
+        sys.exit(1)
+
+
+if __name__ == '__main__':
+    main()
