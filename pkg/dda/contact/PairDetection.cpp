@@ -761,7 +761,7 @@ void prepareSubUnits(Prepared& p, const LinkedSubUnits* linked, int slot, Scratc
 		p.vertexLinked = nullptr;
 		return;
 	}
-	const auto list = [](const std::vector<int>& v) { return Indices{v.data(), static_cast<int>(v.size())}; };
+	const auto list = [](const SubUnitList& v) { return Indices{v.begin(), static_cast<int>(v.size())}; };
 	p.vertexList = list(linked->vertices[slot]);
 	p.edgeList = list(linked->edges[slot]);
 	p.faceList = list(linked->faces[slot]);
@@ -769,6 +769,19 @@ void prepareSubUnits(Prepared& p, const LinkedSubUnits* linked, int slot, Scratc
 	vertexMark.assign(corners, 0);
 	for (int v : linked->vertices[slot]) vertexMark[v] = 1;
 	p.vertexLinked = vertexMark.data();
+}
+
+// Whether the pair's previous entrance feature (if any) is among the sub-units
+// the pair may use.
+bool previousLinked(const Prepared& a, const Prepared& b, const EntranceFeature& previous) {
+	const auto has = [](const Indices& list, int x) { return std::binary_search(list.begin(), list.end(), x); };
+	switch (previous.kind) {
+		case EntranceFeature::FaceOfA: return has(a.faceList, previous.feature);
+		case EntranceFeature::FaceOfB: return has(b.faceList, previous.feature);
+		case EntranceFeature::EdgePair: return has(a.edgeList, previous.feature) && has(b.edgeList, previous.other);
+		case EntranceFeature::None: return true;
+	}
+	return true;
 }
 
 }  // namespace
@@ -895,6 +908,15 @@ std::optional<PairContacts> detectPairContacts(const BlockGeometry& blockA, cons
 			entrance = c.feature;
 			separation = c.separation;
 		}
+	}
+
+	// The same bound holds for the entrance itself, which may be the previous
+	// one kept by hysteresis a little deeper than the best axis; and a
+	// previous entrance that is not linked could have been kept by the full
+	// search: both go to the full search too.
+	if (linked && (!(separation >= -0.5 * d0) || !previousLinked(a, b, previous))) {
+		++work->fullSearches;
+		return detectPairContacts(blockA, blockB, settings, previous, nullptr, work);
 	}
 
 	// 3. Sub-contacts.
