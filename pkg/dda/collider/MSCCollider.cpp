@@ -195,6 +195,7 @@ void MSCCollider::buildCover(const Block& block, double criticalLength, int segm
 void MSCCollider::updateBoxes(const Block& block, BlockCover& cover, Frame& frame) {
 	const ConvexPolyhedron& shape = *block.shape;
 	const std::vector<Vector3>& x = block.vertices;
+	// The frame.
 	frame.axes.setIdentity();
 	if (cover.frameFaces[0] >= 0) {
 		Eigen::Matrix3d axes;
@@ -204,25 +205,22 @@ void MSCCollider::updateBoxes(const Block& block, BlockCover& cover, Frame& fram
 	frame.dual = frame.axes.inverse();
 	frame.origin = x.front();
 	frame.reach = 0;
-	for (int j = 0; j < cover.shellCount; ++j) {
-		const Shell& shell = cover.shells[j];
-		Eigen::AlignedBox3d box;
-		Vector3 low = Vector3::Constant(std::numeric_limits<double>::infinity()), high = -low;
-		const auto add = [&](const Vector3& p) {
-			box.extend(p);
+	for (int s = cover.firstShell; s < cover.firstShell + cover.shellCount; ++s) {
+		Vector3 min = Vector3::Constant(std::numeric_limits<double>::infinity()), max = -min;
+		Vector3 low = min, high = max;
+		for (int k = pointStart_[s]; k < pointStart_[s + 1]; ++k) {
+			const ShellPoint& point = points_[k];
+			const Vector3& from = x[point.from];
+			const Vector3 p = point.from == point.to ? from : Vector3(from + point.fraction * (x[point.to] - from));
+			min = min.cwiseMin(p);
+			max = max.cwiseMax(p);
 			const Vector3 c = frame.axes * (p - frame.origin);
 			low = low.cwiseMin(c);
 			high = high.cwiseMax(c);
-		};
-		for (int v : shell.corners) add(x[v]);
-		for (const DivisionPoint& d : shell.divisions) {
-			const Vector3& p = x[shape.edges[d.edge][0]];
-			const Vector3& q = x[shape.edges[d.edge][1]];
-			add(p + d.fraction * (q - p));
 		}
-		boxes_[cover.firstShell + j] = box;
-		extentLow_[cover.firstShell + j] = low;
-		extentHigh_[cover.firstShell + j] = high;
+		boxes_[s] = Eigen::AlignedBox3d(min, max);
+		extentLow_[s] = low;
+		extentHigh_[s] = high;
 		frame.reach = std::max({frame.reach, low.cwiseAbs().maxCoeff(), high.cwiseAbs().maxCoeff()});
 	}
 	cover.boxesBuilt = block.fixed;
@@ -242,10 +240,20 @@ void MSCCollider::layoutShells() {
 	shellBlock_.resize(total);
 	shellIndex_.resize(total);
 	frames_.resize(covers_.size());
+	points_.clear();
+	pointStart_.assign(1, 0);
 	for (int b = 0; b < static_cast<int>(covers_.size()); ++b)
 		for (int j = 0; j < covers_[b].shellCount; ++j) {
 			shellBlock_[covers_[b].firstShell + j] = b;
 			shellIndex_[covers_[b].firstShell + j] = j;
+			const Shell& shell = covers_[b].shells[j];
+			for (int v : shell.corners) points_.push_back({v, v, 0.0});
+			if (covers_[b].shape)  // (else not built yet: no shells)
+				for (const DivisionPoint& d : shell.divisions) {
+					const auto& edge = covers_[b].shape->edges[d.edge];
+					points_.push_back({edge[0], edge[1], d.fraction});
+				}
+			pointStart_.push_back(static_cast<int>(points_.size()));
 		}
 	cacheValid_ = false;
 }
@@ -337,13 +345,12 @@ long MSCCollider::gridSearch(const std::vector<Block>& blocks, const std::vector
 	return tests;
 }
 
-bool MSCCollider::apartInFrame(int s, int t, const Eigen::Matrix3d& m, const Vector3& offset, double limit) const {
+bool MSCCollider::apartInFrame(int s, int t, const Eigen::Matrix3d& m, const Eigen::Matrix3d& size,
+                               const Vector3& offset, double limit) const {
 	const Vector3 middle = offset + m * (0.5 * (extentLow_[t] + extentHigh_[t]));
-	const Vector3 half = m.cwiseAbs() * (0.5 * (extentHigh_[t] - extentLow_[t]));
-	for (int i = 0; i < 3; ++i)
-		if (extentLow_[s](i) - (middle(i) + half(i)) > limit || (middle(i) - half(i)) - extentHigh_[s](i) > limit)
-			return true;
-	return false;
+	const Vector3 half = size * (0.5 * (extentHigh_[t] - extentLow_[t]));
+	return ((extentLow_[s] - middle - half).array() > limit).any() ||
+	       ((middle - half - extentHigh_[s]).array() > limit).any();
 }
 
 void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDistance,
@@ -482,6 +489,7 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 		const Frame& fb = frames_[b];
 		const Vector3 between = fb.origin - fa.origin;
 		const Eigen::Matrix3d inA = fa.axes * fb.dual, inB = fb.axes * fa.dual;
+		const Eigen::Matrix3d sizeInA = inA.cwiseAbs(), sizeInB = inB.cwiseAbs();
 		const Vector3 offsetInA = fa.axes * between, offsetInB = fb.axes * (-between);
 		const double roundoff =
 		    kFrameRoundoffRelative * (between.cwiseAbs().sum() + 10 * (fa.reach + fb.reach));
@@ -490,7 +498,8 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 		for (; h < end; ++h) {
 			const int s = hits_[h].s, t = hits_[h].t;
 			++stats.shellTests;
-			if (apartInFrame(s, t, inA, offsetInA, limit) || apartInFrame(t, s, inB, offsetInB, limit)) continue;
+			if (apartInFrame(s, t, inA, sizeInA, offsetInA, limit) || apartInFrame(t, s, inB, sizeInB, offsetInB, limit))
+				continue;
 			++stats.shellPairs;
 			c.shellsA |= std::uint64_t{1} << shellIndex_[s];
 			c.shellsB |= std::uint64_t{1} << shellIndex_[t];

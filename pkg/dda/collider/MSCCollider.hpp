@@ -190,9 +190,10 @@ private:
 	long gridSearch(const std::vector<Block>& blocks, const std::vector<Eigen::AlignedBox3d>& boxes,
 	                std::vector<ShellPair>& out);
 	// Whether shells s of block a and t of block b are apart by more than
-	// `limit` [m] along an axis of a's frame (m = a.axes x b.dual, offset =
-	// a.axes x (b.origin - a.origin)).
-	bool apartInFrame(int s, int t, const Eigen::Matrix3d& m, const Vector3& offset, double limit) const;
+	// `limit` [m] along an axis of a's frame (m = a.axes x b.dual, size = |m|
+	// elementwise, offset = a.axes x (b.origin - a.origin)).
+	bool apartInFrame(int s, int t, const Eigen::Matrix3d& m, const Eigen::Matrix3d& size, const Vector3& offset,
+	                  double limit) const;
 	// Index into cover.linkedSets of the set for `shells` (built when new).
 	static int linkedSet(BlockCover& cover, std::uint64_t shells);
 
@@ -205,6 +206,14 @@ private:
 	std::vector<Frame> frames_;               // per block
 	std::vector<Eigen::AlignedBox3d> boxes_;  // per flat shell, not widened
 	std::vector<Vector3> extentLow_, extentHigh_;  // per flat shell, in its block's frame [m]
+	// Every shell's points, flat (shell s: [pointStart_[s], pointStart_[s + 1])):
+	// a corner is (v, v, 0), a division point (edge start, edge end, fraction).
+	struct ShellPoint {
+		int from, to;
+		double fraction;
+	};
+	std::vector<ShellPoint> points_;
+	std::vector<int> pointStart_;
 	std::vector<int> shellBlock_, shellIndex_;  // per flat shell
 	std::vector<Eigen::AlignedBox3d> widened_;
 	std::vector<std::pair<std::uint64_t, int>> cellEntries_;  // (cell key, shell), sorted
