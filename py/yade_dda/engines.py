@@ -158,8 +158,9 @@ class DDAIntegrator(wrapper.PyRunner):
       contacts; only the time differs. A collider engine before the
       integrator (``DESSCollider``, ``NBSCollider``, ...) overrides it.
     - ``reuseCandidatePairs``: diagnostic; True (default) lets the DESS
-      broad phase reuse its candidate pairs while no block has moved past
-      its allowance (d0 per box side), False searches every step. The
+      and MSC broad phases reuse their candidate (MSC: shell) pairs while no
+      block has moved past its allowance (d0 per box side), False searches
+      every step. The
       contacts are the same either way (``stats()['broadPhaseSkipped']``
       counts the skipped searches); False exists to measure what the cache
       saves.

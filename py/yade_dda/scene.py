@@ -187,8 +187,9 @@ def stats():
     (bodies written by the last sync, syncs so far), ``syncTimeTotal`` and
     ``stepTimeTotal`` [s] (all syncs; all integrator calls, sync included).
 
-    Work done or skipped: ``broadPhaseSkipped`` (1 when DESS reused its
-    cached candidate pairs instead of a sort-and-sweep), ``pairsReused``,
+    Work done or skipped: ``broadPhaseSkipped`` (1 when DESS or MSC reused
+    its cached candidate or shell pairs instead of a full search),
+    ``pairsReused``,
     ``blocksResearched`` (blocks searched again; all on a full search),
     ``fixedPairsSearched`` (pairs of two fixed blocks given to the narrow
     phase: always 0), ``frictionTerms`` and ``normalTerms`` (shear springs or

@@ -919,6 +919,51 @@ TEST(ContactDetection, OverlapOfTurnedLogsIsRepresentedByASubContact) {
 	EXPECT_LT(deepest, 0.9 * result->separation) << "no sub-contact carries the overlap";
 }
 
+// Two slender blocks of bench/colliders.py's random deposit (blocks 208 and
+// 267 of the 1,000-block scene) crossing 3.9 mm apart: the pair's entrance is
+// an edge pair; its best face axis lies about 0.7 m deep (crossed logs). The
+// face search of the edge entrance once took its depth limit from that face
+// axis and gave two edge crossings 1.02 m and 0.99 m "deep" between blocks that
+// do not touch (71 negative gaps in a deposit built without any overlap). No
+// sub-contact of a pair may be deeper than the pair's penetration allows.
+TEST(ContactDetection, EdgeEntranceOfCrossedLogsApartHasNoDeepSubContacts) {
+	const std::vector<Vector3> log1 = {
+	    {5.8905440647062832, 7.7240932513911806, 2.5726767893382103},
+	    {8.0317262217166761, 6.2507437197789608, 2.5713944292490027},
+	    {5.7637350192601726, 7.5396774404604949, 2.7190344321411444},
+	    {7.9049171762705654, 6.0663279088482751, 2.7177520720519368},
+	    {5.8196975042169594, 7.6212998704976433, 2.3817697149314352},
+	    {7.9608796612273522, 6.1479503388854235, 2.3804873548422276},
+	    {5.6928884587708488, 7.4368840595669576, 2.5281273577343693},
+	    {7.8340706157812416, 5.9635345279547378, 2.5268449976451617}};
+	const std::vector<Vector3> log2 = {
+	    {7.6730227786901164, 7.2470197837098365, 2.8887584189403088},
+	    {5.3801272983420132, 5.7223336855066069, 3.0512076760008719},
+	    {7.5561195839800295, 7.4426899051781428, 3.0752086852912321},
+	    {5.2632241036319263, 5.9180038069749132, 3.2376579423517948},
+	    {7.5603766780049773, 7.3926172378128401, 2.6653328299785186},
+	    {5.2674811976568741, 5.8679311396096105, 2.8277820870390813},
+	    {7.4434734832948903, 7.5882873592811464, 2.8517830963294415},
+	    {5.1505780029467871, 6.0636012610779169, 3.0142323533900046}};
+	const dda::ConvexPolyhedron a = dda::buildConvexPolyhedron(log1), b = dda::buildConvexPolyhedron(log2);
+	const Vector3 ca = dda::computeMassProperties(a.vertices, a.faces).centroid;
+	const Vector3 cb = dda::computeMassProperties(b.vertices, b.faces).centroid;
+	DetectionSettings settings;
+	settings.contactDistance = 0.01;
+	settings.lengthTolerance = 3e-8;
+	settings.hysteresis = 1e-3;
+	settings.cornerMergeDistance = 2e-3;
+	settings.angleTolerance = 5e-3;
+	const auto result = dda::detectPairContacts(dda::BlockGeometry{&a, &a.vertices, ca}, dda::BlockGeometry{&b, &b.vertices, cb},
+	                                            settings);
+	ASSERT_TRUE(result.has_value());
+	EXPECT_EQ(result->entrance.kind, EntranceFeature::EdgePair);
+	EXPECT_NEAR(result->separation, 3.9e-3, 1e-4);
+	ASSERT_FALSE(result->contacts.empty());
+	for (const SubContact& c : result->contacts)
+		EXPECT_GE(c.gap, -settings.lengthTolerance) << "a sub-contact " << c.gap << " m deep between blocks apart";
+}
+
 // A cube tilted 0.004 rad and turned 0.3 rad over a fixed unit cube, its
 // lowest corner overhanging the fixed cube's edge x = 1 so that the pair's
 // closest features are two edges crossing (an edge entrance). Its far

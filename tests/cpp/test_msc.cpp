@@ -13,6 +13,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <memory>
 #include <random>
@@ -70,7 +71,7 @@ std::optional<PairContacts> detect(const std::vector<Block>& blocks, int a, int 
 	                          detectionSettings(d0));
 }
 
-bool has(const std::vector<int>& sorted, int x) { return std::binary_search(sorted.begin(), sorted.end(), x); }
+bool has(const SubUnitList& sorted, int x) { return std::binary_search(sorted.begin(), sorted.end(), x); }
 
 // Checks that every feature of every sub-contact of the MSC candidates is
 // linked to the pair; returns the number of sub-contacts checked.
@@ -230,6 +231,96 @@ TEST(MSCCollider, FewerCandidatesAndSubUnitLoopsThanDESSOnSlenderScenes) {
 	EXPECT_LT(mscPairs.size(), dessPairs.size());
 	for (int k = 0; k + 1 < 10; ++k)
 		EXPECT_TRUE(std::binary_search(mscPairs.begin(), mscPairs.end(), std::make_pair(k, k + 1))) << k;
+	// Along the blocks' own axes (their frames) the next but one is 1 m away:
+	// the neighbours only, although the 45-degree shells of blocks k and k + 2
+	// overlap as boxes.
+	EXPECT_EQ(mscPairs.size(), 9u);
+	EXPECT_GT(stats.shellTests, stats.shellPairs);
+}
+
+TEST(MSCCollider, FramesAreThreeFacesOfTheBoxAcrossItsMainAxisFirst) {
+	const std::vector<Block> blocks = blocksOf(randomMscScene(40, 3));
+	MSCCollider msc;
+	std::vector<std::pair<int, int>> pairs;
+	BroadPhaseStatistics stats;
+	msc.findPairs(blocks, 0.05, pairs, stats);
+	for (int b = 0; b < static_cast<int>(blocks.size()); ++b) {
+		const Block& block = blocks[b];
+		const std::array<int, 3>& faces = msc.frameFaces(b);
+		Vector3 normals[3];
+		for (int j = 0; j < 3; ++j) {
+			ASSERT_GE(faces[j], 0) << "block " << b;
+			const std::vector<int>& face = block.shape->faces[faces[j]];
+			normals[j] = (block.vertices[face[1]] - block.vertices[face[0]])
+			                 .cross(block.vertices[face[2]] - block.vertices[face[0]])
+			                 .normalized();
+		}
+		// A box: three mutually orthogonal faces.
+		EXPECT_NEAR(std::abs(normals[0].dot(normals[1].cross(normals[2]))), 1, 1e-9) << "block " << b;
+		// The first is across the longest edge (a long block's end).
+		Vector3 longest = Vector3::Zero();
+		for (const auto& e : block.shape->edges) {
+			const Vector3 d = block.vertices[e[1]] - block.vertices[e[0]];
+			if (d.norm() > longest.norm()) longest = d;
+		}
+		if (msc.shellCount(b) > 1) EXPECT_NEAR(std::abs(normals[0].dot(longest.normalized())), 1, 1e-9) << "block " << b;
+	}
+}
+
+TEST(MSCCollider, ShellPairCacheGivesThePairsAndLinkedSetsOfAFullSearch) {
+	// Blocks moved a little (inside the skin) and some far (outside): each
+	// round the cached collider must return what one without cache returns,
+	// pair for pair and linked set for linked set, and the contacts of AllPairs.
+	std::vector<Block> blocks = blocksOf(randomMscScene(120, 8));
+	const double d0 = 0.05;
+	MSCCollider cached, uncached;
+	uncached.setPairReuse(false);
+	std::mt19937 rng(4);
+	std::uniform_real_distribution<double> unit(0, 1);
+	long skipped = 0, partial = 0, reused = 0, full = 0;
+	for (int round = 0; round < 12; ++round) {
+		std::vector<std::pair<int, int>> pairsCached, pairsUncached;
+		BroadPhaseStatistics withCache, without;
+		cached.findPairs(blocks, d0, pairsCached, withCache);
+		uncached.findPairs(blocks, d0, pairsUncached, without);
+		ASSERT_EQ(pairsCached, pairsUncached) << "round " << round;
+		EXPECT_EQ(withCache.shellPairs, without.shellPairs);
+		EXPECT_EQ(withCache.subUnitPairs, without.subUnitPairs);
+		for (int p = 0; p < static_cast<int>(pairsCached.size()); ++p)
+			for (int i = 0; i < 2; ++i) {
+				const LinkedSubUnits& x = *cached.linked(p);
+				const LinkedSubUnits& y = *uncached.linked(p);
+				EXPECT_TRUE(std::equal(x.vertices[i].begin(), x.vertices[i].end(), y.vertices[i].begin(), y.vertices[i].end()));
+				EXPECT_TRUE(std::equal(x.edges[i].begin(), x.edges[i].end(), y.edges[i].begin(), y.edges[i].end()));
+				EXPECT_TRUE(std::equal(x.faces[i].begin(), x.faces[i].end(), y.faces[i].begin(), y.faces[i].end()));
+			}
+		EXPECT_EQ(without.broadPhaseSkipped, 0);
+		skipped += withCache.broadPhaseSkipped;
+		partial += withCache.broadPhaseSkipped && withCache.blocksResearched > 0;
+		reused += withCache.pairsReused;
+		full += withCache.blocksResearched == static_cast<long>(blocks.size());
+		if (round % 4 == 3) {
+			AllPairsCollider all;
+			EXPECT_TRUE(contactSet(cached, blocks, d0) == contactSet(all, blocks, d0)) << "round " << round;
+		}
+		// Every free block drifts by up to 0.3 d0; rounds 2, 5, 8: a few jump by
+		// 2 d0 (re-searched one by one); round 10: most jump (a full search).
+		for (int b = 0; b < static_cast<int>(blocks.size()); ++b) {
+			Block& block = blocks[b];
+			if (block.fixed) continue;
+			const bool jump = (round % 3 == 2 && b % 25 == 0) || (round == 10 && b % 4 != 0);
+			const double step = (jump ? 2.0 : 0.3) * d0;
+			const Vector3 shift = step * Vector3(unit(rng) - 0.5, unit(rng) - 0.5, unit(rng) - 0.5).normalized();
+			const Eigen::Matrix3d turn =
+			    Eigen::AngleAxisd(0.002 * unit(rng), Vector3(unit(rng), unit(rng), unit(rng)).normalized()).toRotationMatrix();
+			for (Vector3& x : block.vertices) x = block.centroid + shift + turn * (x - block.centroid);
+			block.centroid += shift;
+		}
+	}
+	EXPECT_GT(skipped, 6);
+	EXPECT_GE(partial, 3);
+	EXPECT_GT(reused, 0);
+	EXPECT_GE(full, 2);  // the first call and round 10
 }
 
 TEST(MSCCollider, ShellsCoverTheirBlocksAlsoAfterAffineMotion) {

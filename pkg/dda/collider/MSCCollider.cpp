@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 // Why the linked sub-units hold every feature of a pair's contacts. A
@@ -19,6 +20,12 @@
 // gap in [2 min(separation, 0) - reach, reach]: the same bound. So the union
 // over the overlapping shells links them. Deeper overlaps are not covered by
 // this argument (a corner far inside may pick a face beyond its shells).
+// The frame test uses nothing else: for any unit direction u, |(P - q) . u| <=
+// |P - q| <= 2 d0 + wA + wB, so two slices apart by more than that along u
+// hold no such P and q. A slice lies in its extent (the parallelepiped of its
+// ranges along the frame's axes), so a shell is projected on the other
+// frame's axes through that parallelepiped, and the test adds its own
+// round-off (kFrameRoundoffRelative x the lengths involved, far below w).
 
 namespace dda {
 
@@ -34,6 +41,13 @@ void checkCover(double criticalLength, int segments, const std::string& what) {
 
 // The block's size [m]: its creation size, else the cube root of its volume.
 double blockSize(const Block& block) { return block.size > 0 ? block.size : std::cbrt(block.volume); }
+
+// A face's unit normal from its vector area (zero for a degenerate face).
+Vector3 faceNormal(const std::vector<int>& face, const std::vector<Vector3>& x) {
+	Vector3 area = Vector3::Zero();
+	for (std::size_t k = 1; k + 1 < face.size(); ++k) area += (x[face[k]] - x[face[0]]).cross(x[face[k + 1]] - x[face[0]]);
+	return area.normalized();
+}
 
 }  // namespace
 
@@ -57,6 +71,11 @@ void MSCCollider::setBlockCover(int block, double criticalLength, int segments) 
 	checkCover(criticalLength, segments, "MSCCollider block " + std::to_string(block));
 	overrides_[block] = Override{criticalLength, segments};
 	coverChanged_ = true;
+}
+
+void MSCCollider::setPairReuse(bool reuse) {
+	reuse_ = reuse;
+	if (!reuse) cacheValid_ = false;
 }
 
 const LinkedSubUnits* MSCCollider::linked(int pairIndex) const {
@@ -89,13 +108,7 @@ void MSCCollider::buildCover(const Block& block, double criticalLength, int segm
 	const int k = longest > criticalLength ? segments : 1;
 	cover.shellCount = k;
 	cover.shells.assign(k, Shell{});
-	if (k == 1) {
-		for (int v = 0; v < nv; ++v) cover.shells[0].corners.push_back(v);
-		cover.vertexShells.assign(nv, 1);
-		cover.edgeShells.assign(ne, 1);
-		cover.faceShells.assign(nf, 1);
-		return;
-	}
+	cover.linkedSets.clear();
 	// Main axis: the principal direction of largest spread of the corners.
 	Vector3 mean = Vector3::Zero();
 	for (const Vector3& p : x) mean += p;
@@ -104,6 +117,35 @@ void MSCCollider::buildCover(const Block& block, double criticalLength, int segm
 	for (const Vector3& p : x) spread += (p - mean) * (p - mean).transpose();
 	const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(spread);
 	const Vector3 axis = eigen.eigenvectors().col(2);  // eigenvalues ascending
+	// The frame: the face most across the main axis, the face most across
+	// that one, and the face that spans most volume with both.
+	cover.frameFaces = {-1, -1, -1};
+	std::vector<Vector3> normals(nf);
+	for (int f = 0; f < nf; ++f) normals[f] = faceNormal(shape.faces[f], x);
+	const auto best = [&](const auto& score, int skip) {
+		int chosen = -1;
+		double top = -1;
+		for (int f = 0; f < nf; ++f)
+			if (f != skip && score(normals[f]) > top) {
+				top = score(normals[f]);
+				chosen = f;
+			}
+		return chosen;
+	};
+	const int f1 = best([&](const Vector3& n) { return std::abs(n.dot(axis)); }, -1);
+	const int f2 = best([&](const Vector3& n) { return 1 - std::abs(n.dot(normals[f1])); }, f1);
+	if (f2 >= 0) {
+		const Vector3 across = normals[f1].cross(normals[f2]);
+		const int f3 = best([&](const Vector3& n) { return std::abs(n.dot(across)); }, f1);
+		if (f3 >= 0 && std::abs(normals[f3].dot(across)) >= kMinFrameDeterminant) cover.frameFaces = {f1, f2, f3};
+	}
+	if (k == 1) {
+		for (int v = 0; v < nv; ++v) cover.shells[0].corners.push_back(v);
+		cover.vertexShells.assign(nv, 1);
+		cover.edgeShells.assign(ne, 1);
+		cover.faceShells.assign(nf, 1);
+		return;
+	}
 	std::vector<double> s(nv);
 	for (int v = 0; v < nv; ++v) s[v] = axis.dot(x[v] - mean);
 	const double low = *std::min_element(s.begin(), s.end()), high = *std::max_element(s.begin(), s.end());
@@ -150,97 +192,98 @@ void MSCCollider::buildCover(const Block& block, double criticalLength, int segm
 	}
 }
 
-void MSCCollider::updateBoxes(const Block& block, BlockCover& cover) {
+void MSCCollider::updateBoxes(const Block& block, BlockCover& cover, Frame& frame) {
 	const ConvexPolyhedron& shape = *block.shape;
 	const std::vector<Vector3>& x = block.vertices;
-	for (int j = 0; j < cover.shellCount; ++j) {
-		const Shell& shell = cover.shells[j];
-		Eigen::AlignedBox3d box;
-		for (int v : shell.corners) box.extend(x[v]);
-		for (const DivisionPoint& d : shell.divisions) {
-			const Vector3& p = x[shape.edges[d.edge][0]];
-			const Vector3& q = x[shape.edges[d.edge][1]];
-			box.extend(p + d.fraction * (q - p));
-		}
-		boxes_[cover.firstShell + j] = box;
+	// The frame.
+	frame.axes.setIdentity();
+	if (cover.frameFaces[0] >= 0) {
+		Eigen::Matrix3d axes;
+		for (int j = 0; j < 3; ++j) axes.row(j) = faceNormal(shape.faces[cover.frameFaces[j]], x).transpose();
+		if (std::abs(axes.determinant()) >= 0.5 * kMinFrameDeterminant) frame.axes = axes;
 	}
-	cover.boxesBuilt = true;
+	frame.dual = frame.axes.inverse();
+	frame.origin = x.front();
+	frame.reach = 0;
+	for (int s = cover.firstShell; s < cover.firstShell + cover.shellCount; ++s) {
+		Vector3 min = Vector3::Constant(std::numeric_limits<double>::infinity()), max = -min;
+		Vector3 low = min, high = max;
+		for (int k = pointStart_[s]; k < pointStart_[s + 1]; ++k) {
+			const ShellPoint& point = points_[k];
+			const Vector3& from = x[point.from];
+			const Vector3 p = point.from == point.to ? from : Vector3(from + point.fraction * (x[point.to] - from));
+			min = min.cwiseMin(p);
+			max = max.cwiseMax(p);
+			const Vector3 c = frame.axes * (p - frame.origin);
+			low = low.cwiseMin(c);
+			high = high.cwiseMax(c);
+		}
+		boxes_[s] = Eigen::AlignedBox3d(min, max);
+		extentLow_[s] = low;
+		extentHigh_[s] = high;
+		frame.reach = std::max({frame.reach, low.cwiseAbs().maxCoeff(), high.cwiseAbs().maxCoeff()});
+	}
+	cover.boxesBuilt = block.fixed;
 	totalShellUpdates_ += cover.shellCount;
 }
 
-void MSCCollider::collect(const std::vector<std::uint64_t>& linkedShells, std::uint64_t shells, std::vector<int>& out) {
-	out.clear();
-	const int n = static_cast<int>(linkedShells.size());
-	for (int i = 0; i < n; ++i)
-		if (linkedShells[i] & shells) out.push_back(i);
+void MSCCollider::layoutShells() {
+	int total = 0;
+	for (BlockCover& cover : covers_) {
+		cover.firstShell = total;
+		cover.boxesBuilt = false;
+		total += cover.shellCount;
+	}
+	boxes_.resize(total);
+	extentLow_.resize(total);
+	extentHigh_.resize(total);
+	shellBlock_.resize(total);
+	shellIndex_.resize(total);
+	frames_.resize(covers_.size());
+	points_.clear();
+	pointStart_.assign(1, 0);
+	for (int b = 0; b < static_cast<int>(covers_.size()); ++b)
+		for (int j = 0; j < covers_[b].shellCount; ++j) {
+			shellBlock_[covers_[b].firstShell + j] = b;
+			shellIndex_[covers_[b].firstShell + j] = j;
+			const Shell& shell = covers_[b].shells[j];
+			for (int v : shell.corners) points_.push_back({v, v, 0.0});
+			if (covers_[b].shape)  // (else not built yet: no shells)
+				for (const DivisionPoint& d : shell.divisions) {
+					const auto& edge = covers_[b].shape->edges[d.edge];
+					points_.push_back({edge[0], edge[1], d.fraction});
+				}
+			pointStart_.push_back(static_cast<int>(points_.size()));
+		}
+	cacheValid_ = false;
 }
 
-void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDistance,
-                            std::vector<std::pair<int, int>>& pairs, BroadPhaseStatistics& stats) {
-	pairs.clear();
-	stats = BroadPhaseStatistics{};
-	linkedCount_ = 0;
-	const int n = static_cast<int>(blocks.size());
+int MSCCollider::linkedSet(BlockCover& cover, std::uint64_t shells) {
+	const int count = static_cast<int>(cover.linkedSets.size());
+	for (int k = 0; k < count; ++k)
+		if (cover.linkedSets[k].shells == shells) return k;
+	LinkedSet& set = cover.linkedSets.emplace_back();
+	set.shells = shells;
+	const auto collect = [shells](const std::vector<std::uint64_t>& linkedShells, std::vector<int>& out) {
+		for (int i = 0; i < static_cast<int>(linkedShells.size()); ++i)
+			if (linkedShells[i] & shells) out.push_back(i);
+	};
+	collect(cover.vertexShells, set.vertices);
+	collect(cover.edgeShells, set.edges);
+	collect(cover.faceShells, set.faces);
+	return count;
+}
 
-	// Topology: the block count changed (all), a block's shape changed, or the
-	// cover's parameters changed (blocks whose parameters differ).
-	bool layoutChanged = false;
-	if (static_cast<int>(covers_.size()) != n) {
-		covers_.assign(n, BlockCover{});
-		layoutChanged = true;
-	}
-	for (int b = 0; b < n; ++b) {
-		BlockCover& cover = covers_[b];
-		const bool fresh = cover.shape != blocks[b].shape.get();
-		if (!fresh && !coverChanged_) continue;
-		const auto own = overrides_.find(b);
-		const double criticalLength = own != overrides_.end() ? own->second.criticalLength
-		                              : criticalLength_ > 0  ? criticalLength_
-		                                                     : criticalLengthFactor_ * blockSize(blocks[b]);
-		const int segments = own != overrides_.end() ? own->second.segments : segments_;
-		if (!fresh && criticalLength == cover.criticalLength && segments == cover.segments) continue;
-		buildCover(blocks[b], criticalLength, segments, cover);
-		++coverBuilds_;
-		layoutChanged = true;
-	}
-	coverChanged_ = false;
-	if (layoutChanged) {
-		int total = 0;
-		for (BlockCover& cover : covers_) {
-			cover.firstShell = total;
-			cover.boxesBuilt = false;
-			total += cover.shellCount;
-		}
-		boxes_.resize(total);
-		shellBlock_.resize(total);
-		shellIndex_.resize(total);
-		for (int b = 0; b < n; ++b)
-			for (int j = 0; j < covers_[b].shellCount; ++j) {
-				shellBlock_[covers_[b].firstShell + j] = b;
-				shellIndex_[covers_[b].firstShell + j] = j;
-			}
-	}
-	const int shellTotal = static_cast<int>(boxes_.size());
-	stats.shells = shellTotal;
-
-	// Boxes: moving blocks every call, fixed blocks once.
-	const long updatesBefore = totalShellUpdates_;
-	for (int b = 0; b < n; ++b)
-		if (!blocks[b].fixed || !covers_[b].boxesBuilt) updateBoxes(blocks[b], covers_[b]);
-	stats.shellUpdates = totalShellUpdates_ - updatesBefore;
-	if (n < 2) return;
-
-	widened_.resize(shellTotal);
+long MSCCollider::gridSearch(const std::vector<Block>& blocks, const std::vector<Eigen::AlignedBox3d>& boxes,
+                             std::vector<ShellPair>& out) {
+	out.clear();
+	const int shellTotal = static_cast<int>(boxes.size());
 	Eigen::AlignedBox3d domain;
 	double sideSum = 0;
-	const double margin = kBroadPhaseMarginFactor * contactDistance;
-	for (int s = 0; s < shellTotal; ++s) {
-		const Vector3 w = Vector3::Constant(margin + covers_[shellBlock_[s]].widening);
-		widened_[s] = Eigen::AlignedBox3d(boxes_[s].min() - w, boxes_[s].max() + w);
-		domain.extend(widened_[s]);
-		sideSum += widened_[s].sizes().maxCoeff();
+	for (const Eigen::AlignedBox3d& box : boxes) {
+		domain.extend(box);
+		sideSum += box.sizes().maxCoeff();
 	}
-
 	// Subspaces: cubic cells as wide as the mean shell's largest side (at
 	// least 1/kMaxCellsPerAxis of the domain). A shell enters every cell it
 	// overlaps; one spanning more than kMaxCellsPerShell cells (a floor, a
@@ -259,7 +302,7 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 	cellEntries_.clear();
 	oversize_.clear();
 	for (int s = 0; s < shellTotal; ++s) {
-		const Eigen::Array<long, 3, 1> lo = cellOf(widened_[s].min()), hi = cellOf(widened_[s].max());
+		const Eigen::Array<long, 3, 1> lo = cellOf(boxes[s].min()), hi = cellOf(boxes[s].max());
 		const Eigen::Array<long, 3, 1> span = hi - lo + 1;
 		if (span.prod() > kMaxCellsPerShell) {
 			oversize_.push_back(s);
@@ -274,14 +317,13 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 	isOversize_.assign(shellTotal, 0);
 	for (int s : oversize_) isOversize_[s] = 1;
 
-	hits_.clear();
+	long tests = 0;
 	const auto compare = [&](int s, int t) {
 		const int a = shellBlock_[s], b = shellBlock_[t];
 		if (a == b || (blocks[a].fixed && blocks[b].fixed)) return;
-		++stats.shellTests;
-		if (!widened_[s].intersects(widened_[t])) return;
-		const std::uint64_t bitS = std::uint64_t{1} << shellIndex_[s], bitT = std::uint64_t{1} << shellIndex_[t];
-		hits_.push_back(a < b ? ShellHit{a, b, bitS, bitT} : ShellHit{b, a, bitT, bitS});
+		++tests;
+		if (!boxes[s].intersects(boxes[t])) return;
+		out.push_back(a < b ? ShellPair{a, b, s, t} : ShellPair{b, a, t, s});
 	};
 	const std::size_t entries = cellEntries_.size();
 	for (std::size_t first = 0; first < entries;) {
@@ -291,7 +333,7 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 		for (std::size_t p = first; p < last; ++p)
 			for (std::size_t q = p + 1; q < last; ++q) {
 				const int s = cellEntries_[p].second, t = cellEntries_[q].second;
-				const Vector3 low = widened_[s].min().cwiseMax(widened_[t].min());
+				const Vector3 low = boxes[s].min().cwiseMax(boxes[t].min());
 				if (key(cellOf(low)) != here) continue;  // compared in another cell
 				compare(s, t);
 			}
@@ -300,26 +342,187 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 	for (int s : oversize_)
 		for (int t = 0; t < shellTotal; ++t)
 			if (t != s && (!isOversize_[t] || s < t)) compare(s, t);
-	stats.shellPairs = static_cast<long>(hits_.size());
-	std::sort(hits_.begin(), hits_.end());
+	return tests;
+}
 
-	// One candidate per block pair, linking the union of its overlapping shells' sub-units.
-	for (std::size_t h = 0; h < hits_.size();) {
-		ShellHit merged = hits_[h];
-		for (++h; h < hits_.size() && hits_[h].a == merged.a && hits_[h].b == merged.b; ++h) {
-			merged.shellsA |= hits_[h].shellsA;
-			merged.shellsB |= hits_[h].shellsB;
+bool MSCCollider::apartInFrame(int s, int t, const Eigen::Matrix3d& m, const Eigen::Matrix3d& size,
+                               const Vector3& offset, double limit) const {
+	const Vector3 middle = offset + m * (0.5 * (extentLow_[t] + extentHigh_[t]));
+	const Vector3 half = size * (0.5 * (extentHigh_[t] - extentLow_[t]));
+	return ((extentLow_[s] - middle - half).array() > limit).any() ||
+	       ((middle - half - extentHigh_[s]).array() > limit).any();
+}
+
+void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDistance,
+                            std::vector<std::pair<int, int>>& pairs, BroadPhaseStatistics& stats) {
+	pairs.clear();
+	stats = BroadPhaseStatistics{};
+	linkedCount_ = 0;
+	const int n = static_cast<int>(blocks.size());
+
+	// Topology: the block count changed (all), a block's shape changed, or the
+	// cover's parameters changed (blocks whose parameters differ).
+	bool layoutChanged = false;
+	if (static_cast<int>(covers_.size()) != n) {
+		covers_.assign(n, BlockCover{});
+		layoutChanged = true;
+	}
+	for (int b = 0; b < n; ++b) {
+		BlockCover& cover = covers_[b];
+		if (cover.linkedSets.size() > kMaxLinkedSetsPerBlock) cover.linkedSets.clear();
+		const bool fresh = cover.shape != blocks[b].shape.get();
+		if (!fresh && !coverChanged_) continue;
+		const auto own = overrides_.find(b);
+		const double criticalLength = own != overrides_.end() ? own->second.criticalLength
+		                              : criticalLength_ > 0  ? criticalLength_
+		                                                     : criticalLengthFactor_ * blockSize(blocks[b]);
+		const int segments = own != overrides_.end() ? own->second.segments : segments_;
+		if (!fresh && criticalLength == cover.criticalLength && segments == cover.segments) continue;
+		buildCover(blocks[b], criticalLength, segments, cover);
+		++coverBuilds_;
+		layoutChanged = true;
+	}
+	coverChanged_ = false;
+	if (layoutChanged) layoutShells();
+	const int shellTotal = static_cast<int>(boxes_.size());
+	stats.shells = shellTotal;
+
+	// Boxes, frames and extents: moving blocks every call, fixed blocks once.
+	const long updatesBefore = totalShellUpdates_;
+	for (int b = 0; b < n; ++b)
+		if (!blocks[b].fixed || !covers_[b].boxesBuilt) updateBoxes(blocks[b], covers_[b], frames_[b]);
+	stats.shellUpdates = totalShellUpdates_ - updatesBefore;
+	if (n < 2) return;
+
+	const double margin = kBroadPhaseMarginFactor * contactDistance;
+	const double searchMargin = margin * (1 + kVerletSkinFactor);
+	widened_.resize(shellTotal);
+	for (int s = 0; s < shellTotal; ++s) {
+		const Vector3 w = Vector3::Constant(margin + covers_[shellBlock_[s]].widening);
+		widened_[s] = Eigen::AlignedBox3d(boxes_[s].min() - w, boxes_[s].max() + w);
+	}
+	const auto searchBox = [&](int s) {
+		const Vector3 w = Vector3::Constant(searchMargin + covers_[shellBlock_[s]].widening);
+		return Eigen::AlignedBox3d(boxes_[s].min() - w, boxes_[s].max() + w);
+	};
+
+	// Shell pairs whose d0-boxes meet, sorted.
+	hits_.clear();
+	if (!reuse_) {
+		cacheValid_ = false;
+		stats.shellTests = gridSearch(blocks, widened_, hits_);
+		stats.blocksResearched = n;
+		std::sort(hits_.begin(), hits_.end());
+	} else {
+		// Blocks with a d0-box outside its D-box (the same floats as the
+		// final test: boxes inside D-boxes that meet imply D-boxes that meet).
+		bool full = !cacheValid_ || static_cast<int>(searchedFixed_.size()) != n;
+		movers_.clear();
+		moved_.assign(n, 0);
+		for (int b = 0; b < n && !full; ++b) {
+			if (static_cast<char>(blocks[b].fixed) != searchedFixed_[b]) {
+				full = true;
+				break;
+			}
+			const BlockCover& cover = covers_[b];
+			for (int s = cover.firstShell; s < cover.firstShell + cover.shellCount; ++s)
+				if (!searchBoxes_[s].contains(widened_[s])) {
+					movers_.push_back(b);
+					moved_[b] = 1;
+					break;
+				}
 		}
-		pairs.emplace_back(merged.a, merged.b);
-		if (linkedCount_ == static_cast<int>(linked_.size())) linked_.emplace_back();
+		if (!full && static_cast<double>(movers_.size()) > kVerletPartialFactor * std::log2(std::max(2, n))) full = true;
+		if (full) {
+			searchBoxes_.resize(shellTotal);
+			for (int s = 0; s < shellTotal; ++s) searchBoxes_[s] = searchBox(s);
+			searchedFixed_.resize(n);
+			for (int b = 0; b < n; ++b) searchedFixed_[b] = blocks[b].fixed;
+			stats.shellTests = gridSearch(blocks, searchBoxes_, cached_);
+			std::sort(cached_.begin(), cached_.end());
+			stats.blocksResearched = n;
+			cacheValid_ = true;
+		} else {
+			stats.broadPhaseSkipped = 1;
+			stats.blocksResearched = static_cast<long>(movers_.size());
+			if (!movers_.empty()) {
+				// Each mover's shells get new D-boxes and are compared with every shell.
+				for (int m : movers_) {
+					const BlockCover& cover = covers_[m];
+					for (int s = cover.firstShell; s < cover.firstShell + cover.shellCount; ++s)
+						searchBoxes_[s] = searchBox(s);
+				}
+				kept_.clear();
+				for (const ShellPair& p : cached_)
+					if (!moved_[p.a] && !moved_[p.b]) kept_.push_back(p);
+				stats.pairsReused = static_cast<long>(kept_.size());
+				for (int m : movers_) {
+					const BlockCover& cover = covers_[m];
+					for (int s = cover.firstShell; s < cover.firstShell + cover.shellCount; ++s)
+						for (int t = 0; t < shellTotal; ++t) {
+							const int b = shellBlock_[t];
+							if (b == m || (moved_[b] && b < m) || (blocks[b].fixed && blocks[m].fixed)) continue;
+							++stats.shellTests;
+							if (searchBoxes_[s].intersects(searchBoxes_[t]))
+								kept_.push_back(m < b ? ShellPair{m, b, s, t} : ShellPair{b, m, t, s});
+						}
+				}
+				std::sort(kept_.begin(), kept_.end());
+				cached_.swap(kept_);
+			} else {
+				stats.pairsReused = static_cast<long>(cached_.size());
+			}
+		}
+		for (const ShellPair& p : cached_)
+			if (widened_[p.s].intersects(widened_[p.t])) hits_.push_back(p);
+		stats.shellTests += static_cast<long>(cached_.size());
+	}
+
+	// Per block pair: the shell pairs that also overlap in both frames, and
+	// the union of their shells.
+	candidates_.clear();
+	for (std::size_t h = 0; h < hits_.size();) {
+		const int a = hits_[h].a, b = hits_[h].b;
+		std::size_t end = h + 1;
+		while (end < hits_.size() && hits_[end].a == a && hits_[end].b == b) ++end;
+		const Frame& fa = frames_[a];
+		const Frame& fb = frames_[b];
+		const Vector3 between = fb.origin - fa.origin;
+		const Eigen::Matrix3d inA = fa.axes * fb.dual, inB = fb.axes * fa.dual;
+		const Eigen::Matrix3d sizeInA = inA.cwiseAbs(), sizeInB = inB.cwiseAbs();
+		const Vector3 offsetInA = fa.axes * between, offsetInB = fb.axes * (-between);
+		const double roundoff =
+		    kFrameRoundoffRelative * (between.cwiseAbs().sum() + 10 * (fa.reach + fb.reach));
+		const double limit = 2 * margin + covers_[a].widening + covers_[b].widening + roundoff;
+		Candidate c{a, b, 0, 0};
+		for (; h < end; ++h) {
+			const int s = hits_[h].s, t = hits_[h].t;
+			++stats.shellTests;
+			if (apartInFrame(s, t, inA, sizeInA, offsetInA, limit) || apartInFrame(t, s, inB, sizeInB, offsetInB, limit))
+				continue;
+			++stats.shellPairs;
+			c.shellsA |= std::uint64_t{1} << shellIndex_[s];
+			c.shellsB |= std::uint64_t{1} << shellIndex_[t];
+		}
+		if (c.shellsA) candidates_.push_back(c);
+	}
+
+	// One candidate per block pair, linking the union of its overlapping
+	// shells' sub-units (lists shared per block and shell set; all are built
+	// before any is referenced).
+	for (Candidate& c : candidates_) {
+		c.setA = linkedSet(covers_[c.a], c.shellsA);
+		c.setB = linkedSet(covers_[c.b], c.shellsB);
+	}
+	if (linked_.size() < candidates_.size()) linked_.resize(candidates_.size());
+	for (const Candidate& c : candidates_) {
+		pairs.emplace_back(c.a, c.b);
 		LinkedSubUnits& out = linked_[linkedCount_++];
-		const int block[2] = {merged.a, merged.b};
-		const std::uint64_t shells[2] = {merged.shellsA, merged.shellsB};
+		const LinkedSet* sets[2] = {&covers_[c.a].linkedSets[c.setA], &covers_[c.b].linkedSets[c.setB]};
 		for (int i = 0; i < 2; ++i) {
-			const BlockCover& cover = covers_[block[i]];
-			collect(cover.vertexShells, shells[i], out.vertices[i]);
-			collect(cover.edgeShells, shells[i], out.edges[i]);
-			collect(cover.faceShells, shells[i], out.faces[i]);
+			out.vertices[i] = SubUnitList(sets[i]->vertices);
+			out.edges[i] = SubUnitList(sets[i]->edges);
+			out.faces[i] = SubUnitList(sets[i]->faces);
 		}
 		stats.subUnitPairs += out.subUnitPairs();
 	}

@@ -9,19 +9,38 @@
 // linked shells). DDA moves blocks by affine maps, which keep fractions and
 // slab membership: the cover moves with the block, and each step only moving
 // blocks' boxes are recomputed. Shells widened by d0 are entered in the
-// cells of a uniform grid (the paper's subspaces) and compared within cells;
-// a pair is a candidate when two of its shells overlap. Where the paper lets the
-// nearest shell decide, a pair here links the union of its overlapping shells'
-// sub-units, each once: every feature of its contacts while penetration stays
+// cells of a uniform grid (the paper's subspaces) and compared within cells.
+//
+// Two shells whose boxes overlap are then compared along the block's own
+// axes: each block has a frame of three of its face normals (chosen once,
+// the first across the main axis; a box's frame is its edges' directions),
+// and each shell its extent along them (the slab of a box is exactly its
+// extent box there). Two shells apart by more than the boxes' widening along
+// an axis of either frame do not overlap, whatever the boxes say: a slender
+// block turned 45 degrees has boxes far larger than its slabs. A pair is a
+// candidate when two of its shells overlap in both tests. Where the paper lets
+// the nearest shell decide, a pair here links the union of its overlapping
+// shells' sub-units, each once (lists built once per block and shell set,
+// shared by the pairs): every feature of its contacts while penetration stays
 // below d0 / 2 (argued in the .cpp). The narrow phase (detectPairContacts with
 // the linked sets) loops over those only and searches a deeper pair again
 // with every sub-unit, so its contacts are exactly the full search's.
+//
+// Shell-pair cache (on unless setPairReuse(false)), as DESS's: the grid is
+// searched with boxes widened by D = d0 (1 + kVerletSkinFactor), and every
+// shell pair whose D-boxes meet is kept with the D-boxes; a block whose
+// d0-boxes all lie in their D-boxes needs no search, the others are compared
+// with every shell (a full grid search when more than kVerletPartialFactor x
+// log2(n) blocks moved). The shell pairs then tested are the cached ones whose
+// d0-boxes meet, on the same floats as without cache: the pairs, linked sets
+// and their order never depend on the cache.
 #pragma once
 
 #include "Collider.hpp"
 
 #include <Eigen/Geometry>
 
+#include <array>
 #include <cstdint>
 #include <map>
 #include <utility>
@@ -50,6 +69,20 @@ public:
 	// every shell rather than entered in each.
 	static constexpr long kMaxCellsPerAxis = 1 << 20;
 	static constexpr long kMaxCellsPerShell = 64;
+	// A frame is used when its three unit face normals span at least this
+	// volume (|det|, 1 for orthogonal ones) when chosen, and half of it at each
+	// step (a strained block); else the coordinate axes are its frame [-].
+	static constexpr double kMinFrameDeterminant = 0.5;
+	// The frame test's own round-off: this x the lengths it is computed from
+	// [-] is added to the widening (~1e-14 is the bound with the frames above).
+	static constexpr double kFrameRoundoffRelative = 1e-12;
+	// Shell-pair cache, as DESSCollider's: skin x d0, and the most blocks
+	// (x log2(n)) re-searched one by one instead of a full grid search.
+	static constexpr double kVerletSkinFactor = 1.0;
+	static constexpr double kVerletPartialFactor = 4.0;
+	// Linked-set lists kept per block (one per shell set met); more are dropped
+	// at the next call.
+	static constexpr std::size_t kMaxLinkedSetsPerBlock = 64;
 
 	// criticalLengthFactor > 0 [-], segments in [1, kMaxSegments]; InputError otherwise.
 	explicit MSCCollider(double criticalLengthFactor = kDefaultCriticalLengthFactor,
@@ -59,6 +92,7 @@ public:
 	void findPairs(const std::vector<Block>& blocks, double contactDistance, std::vector<std::pair<int, int>>& pairs,
 	               BroadPhaseStatistics& stats) override;
 	const LinkedSubUnits* linked(int pairIndex) const override;
+	void setPairReuse(bool reuse) override;
 
 	// The scene's cover (what yade_dda's MSCCollider engine sets): critical
 	// length [m] >= 0, 0 = criticalLengthFactor x each block's size; segments
@@ -82,9 +116,13 @@ public:
 	// Topology builds (block covers) since construction.
 	long coverBuilds() const { return coverBuilds_; }
 
+	// The faces whose normals make a block's frame, or -1s (coordinate axes).
+	const std::array<int, 3>& frameFaces(int block) const { return covers_.at(block).frameFaces; }
+
 	// Saving (MSCColliderState.cpp): parameters, overrides and every block's
 	// cover as built (a cover is built from the block's geometry at that
-	// time, so rebuilding it later would give other slabs).
+	// time, so rebuilding it later would give other slabs). Boxes, frames and
+	// the cache are recomputed from the blocks (fixed blocks have not moved).
 	void writeState(StateWriter& out) const override;
 	void readState(StateReader& in, const std::vector<Block>& blocks) override;
 
@@ -97,6 +135,11 @@ private:
 		std::vector<int> corners;             // vertices inside the slab
 		std::vector<DivisionPoint> divisions;  // edges crossing the slab's planes
 	};
+	// The sub-units linked to a set of a block's shells.
+	struct LinkedSet {
+		std::uint64_t shells;
+		std::vector<int> vertices, edges, faces;
+	};
 	struct BlockCover {
 		const ConvexPolyhedron* shape = nullptr;  // the cover is rebuilt when it changes
 		double criticalLength = 0;                // [m], as built
@@ -104,25 +147,55 @@ private:
 		int shellCount = 0;
 		int firstShell = 0;  // into the flat shell arrays
 		double widening = 0;  // [m]: kShellWideningRelative x diagonal
+		// Boxes and frame computed while the block was fixed (kept until it moves).
 		bool boxesBuilt = false;
+		std::array<int, 3> frameFaces{-1, -1, -1};
 		std::vector<Shell> shells;
 		// Bit s: linked to shell s (touches its slab).
 		std::vector<std::uint64_t> vertexShells, edgeShells, faceShells;
+		std::vector<LinkedSet> linkedSets;  // built on demand, not saved
+	};
+	// A block's frame at this step: rows of `axes` are unit face normals (or
+	// the coordinate axes), `dual` = axes^-1; a shell's extent is the range of
+	// axes x (p - origin) over its points p.
+	struct Frame {
+		Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();
+		Eigen::Matrix3d dual = Eigen::Matrix3d::Identity();
+		Vector3 origin = Vector3::Zero();
+		double reach = 0;  // [m], largest |extent| of its shells (round-off scale)
 	};
 	struct Override {
 		double criticalLength;
 		int segments;
 	};
-	// One overlapping shell pair, as the block pair (a < b) and the shells of each.
-	struct ShellHit {
+	// A shell pair, as the block pair (a < b) and a shell of each (flat indices).
+	struct ShellPair {
+		int a, b, s, t;
+		bool operator<(const ShellPair& o) const {
+			return a < o.a || (a == o.a && (b < o.b || (b == o.b && (s < o.s || (s == o.s && t < o.t)))));
+		}
+	};
+	// A candidate: the block pair and the shells of each that overlap.
+	struct Candidate {
 		int a, b;
 		std::uint64_t shellsA, shellsB;
-		bool operator<(const ShellHit& o) const { return a < o.a || (a == o.a && b < o.b); }
+		int setA = -1, setB = -1;  // into the blocks' linkedSets
 	};
 
 	void buildCover(const Block& block, double criticalLength, int segments, BlockCover& cover) const;
-	void updateBoxes(const Block& block, BlockCover& cover);
-	static void collect(const std::vector<std::uint64_t>& linkedShells, std::uint64_t shells, std::vector<int>& out);
+	void layoutShells();
+	void updateBoxes(const Block& block, BlockCover& cover, Frame& frame);
+	// Grid search: every shell pair (different blocks, not both fixed) whose
+	// `boxes` meet, into `out` (unsorted); returns the box comparisons made.
+	long gridSearch(const std::vector<Block>& blocks, const std::vector<Eigen::AlignedBox3d>& boxes,
+	                std::vector<ShellPair>& out);
+	// Whether shells s of block a and t of block b are apart by more than
+	// `limit` [m] along an axis of a's frame (m = a.axes x b.dual, size = |m|
+	// elementwise, offset = a.axes x (b.origin - a.origin)).
+	bool apartInFrame(int s, int t, const Eigen::Matrix3d& m, const Eigen::Matrix3d& size, const Vector3& offset,
+	                  double limit) const;
+	// Index into cover.linkedSets of the set for `shells` (built when new).
+	static int linkedSet(BlockCover& cover, std::uint64_t shells);
 
 	double criticalLengthFactor_;
 	double criticalLength_ = 0;
@@ -130,17 +203,36 @@ private:
 	std::map<int, Override> overrides_;
 	bool coverChanged_ = false;
 	std::vector<BlockCover> covers_;
+	std::vector<Frame> frames_;               // per block
 	std::vector<Eigen::AlignedBox3d> boxes_;  // per flat shell, not widened
+	std::vector<Vector3> extentLow_, extentHigh_;  // per flat shell, in its block's frame [m]
+	// Every shell's points, flat (shell s: [pointStart_[s], pointStart_[s + 1])):
+	// a corner is (v, v, 0), a division point (edge start, edge end, fraction).
+	struct ShellPoint {
+		int from, to;
+		double fraction;
+	};
+	std::vector<ShellPoint> points_;
+	std::vector<int> pointStart_;
 	std::vector<int> shellBlock_, shellIndex_;  // per flat shell
 	std::vector<Eigen::AlignedBox3d> widened_;
 	std::vector<std::pair<std::uint64_t, int>> cellEntries_;  // (cell key, shell), sorted
 	std::vector<int> oversize_;   // shells compared with every shell
 	std::vector<char> isOversize_;
-	std::vector<ShellHit> hits_;
-	std::vector<LinkedSubUnits> linked_;  // pool: the first linkedCount_ are valid
+	std::vector<ShellPair> hits_;
+	std::vector<Candidate> candidates_;
+	std::vector<LinkedSubUnits> linked_;  // the first linkedCount_ are valid
 	int linkedCount_ = 0;
 	long totalShellUpdates_ = 0;
 	long coverBuilds_ = 0;
+	// The cache: each shell's D-box from its block's last search, every shell
+	// pair whose D-boxes meet (sorted), and the fixed flags then.
+	bool reuse_ = true;
+	bool cacheValid_ = false;
+	std::vector<Eigen::AlignedBox3d> searchBoxes_;
+	std::vector<ShellPair> cached_, kept_;
+	std::vector<char> searchedFixed_, moved_;
+	std::vector<int> movers_;
 };
 
 }  // namespace dda

@@ -1,8 +1,13 @@
 // Saving and restoring MSCCollider's covers (Collider::writeState/readState).
 // A block's cover is built from its geometry when first seen (and again when
 // the block count or the cover's parameters change), so it depends on the
-// history of the scene; it is written as built, with the shell boxes of the
-// fixed blocks (built once). Per-call work arrays are not written.
+// history of the scene; it is written as built, with its frame faces and
+// whether the block's shell boxes were built while it was fixed (built once).
+// Those boxes, frames and extents are not written: readState computes them
+// again from the restored vertices, which are the ones they were built from,
+// so they come out the same (and are not counted as updates again). The
+// shell-pair cache, which never changes the pairs, starts empty. Per-call work
+// arrays are not written.
 #include "MSCCollider.hpp"
 #include "dda/solver/StateStream.hpp"
 
@@ -26,9 +31,9 @@ void MSCCollider::writeState(StateWriter& out) const {
 		out.pod(c.criticalLength);
 		out.pod(c.segments);
 		out.pod(c.shellCount);
-		out.pod(c.firstShell);
 		out.pod(c.widening);
 		out.pod(static_cast<std::uint8_t>(c.boxesBuilt));
+		for (int f : c.frameFaces) out.pod(f);
 		out.size(c.shells.size());
 		for (const Shell& s : c.shells) {
 			out.podVector(s.corners);
@@ -42,13 +47,6 @@ void MSCCollider::writeState(StateWriter& out) const {
 		out.podVector(c.edgeShells);
 		out.podVector(c.faceShells);
 	}
-	out.size(boxes_.size());
-	for (const auto& box : boxes_) {
-		out.matrix(box.min());
-		out.matrix(box.max());
-	}
-	out.podVector(shellBlock_);
-	out.podVector(shellIndex_);
 	out.pod(totalShellUpdates_);
 	out.pod(coverBuilds_);
 }
@@ -69,6 +67,7 @@ void MSCCollider::readState(StateReader& in, const std::vector<Block>& blocks) {
 	}
 	m.coverChanged_ = in.pod<std::uint8_t>() != 0;
 	m.covers_.resize(in.size(8, "MSC covers"));
+	std::vector<char> boxesBuilt(m.covers_.size());
 	if (m.covers_.size() > blocks.size()) in.fail("more MSC covers than blocks");
 	for (std::size_t b = 0; b < m.covers_.size(); ++b) {
 		BlockCover& c = m.covers_[b];
@@ -77,9 +76,15 @@ void MSCCollider::readState(StateReader& in, const std::vector<Block>& blocks) {
 		in.pod(c.criticalLength);
 		in.pod(c.segments);
 		in.pod(c.shellCount);
-		in.pod(c.firstShell);
 		in.pod(c.widening);
-		c.boxesBuilt = in.pod<std::uint8_t>() != 0;
+		// (A block freed since is recomputed at the next call either way.)
+		boxesBuilt[b] = in.pod<std::uint8_t>() != 0 && built && blocks[b].fixed;
+		for (int& f : c.frameFaces) in.pod(f);
+		const int faces = static_cast<int>(blocks[b].shape->faces.size());
+		const auto inRange = [faces](int f) { return f >= 0 && f < faces; };
+		const auto& ff = c.frameFaces;
+		if (!(ff[0] == -1 && ff[1] == -1 && ff[2] == -1) && !(inRange(ff[0]) && inRange(ff[1]) && inRange(ff[2])))
+			in.fail("MSC frame faces of block " + std::to_string(b) + " out of range");
 		c.shells.resize(in.size(16, "MSC shells"));
 		if (static_cast<int>(c.shells.size()) != c.shellCount || c.shellCount > kMaxSegments)
 			in.fail("MSC cover of block " + std::to_string(b) + " has an inconsistent shell count");
@@ -103,24 +108,13 @@ void MSCCollider::readState(StateReader& in, const std::vector<Block>& blocks) {
 		              c.faceShells.size() != blocks[b].shape->faces.size()))
 			in.fail("MSC cover of block " + std::to_string(b) + " does not match the block's topology");
 	}
-	m.boxes_.resize(in.size(6 * sizeof(double), "shell boxes"));
-	for (auto& box : m.boxes_) {
-		Vector3 low, high;
-		in.matrix(low);
-		in.matrix(high);
-		box = Eigen::AlignedBox3d(low, high);
-	}
-	in.podVector(m.shellBlock_, "shell blocks");
-	in.podVector(m.shellIndex_, "shell indices");
-	for (int b : m.shellBlock_)
-		if (b < 0 || b >= static_cast<int>(m.covers_.size())) in.fail("shell of block " + std::to_string(b));
-	for (const BlockCover& c : m.covers_)
-		if (c.firstShell < 0 || c.firstShell + c.shellCount > static_cast<int>(m.boxes_.size()))
-			if (c.shape) in.fail("MSC shells out of range");
-	if (m.shellBlock_.size() != m.boxes_.size() || m.shellIndex_.size() != m.boxes_.size())
-		in.fail("MSC shell arrays differ in length");
 	in.pod(m.totalShellUpdates_);
 	in.pod(m.coverBuilds_);
+	m.layoutShells();
+	const long updates = m.totalShellUpdates_;
+	for (std::size_t b = 0; b < m.covers_.size(); ++b)
+		if (boxesBuilt[b]) m.updateBoxes(blocks[b], m.covers_[b], m.frames_[b]);
+	m.totalShellUpdates_ = updates;
 	*this = std::move(m);
 }
 

@@ -540,6 +540,14 @@ bool besideVertexContact(const SubContact& crossing, const std::vector<SubContac
 
 // Step 3 for a face entrance: face f of block `owner` (block j of every
 // vertex-face contact of the other block's corners) entered by block `other`.
+// `separation` is the pair's (its entrance axis's, <= 0 when they overlap):
+// no sub-contact is deeper than the pair's penetration allows. For a face
+// entrance it is f's own separation, the lowest corner's distance from f's
+// plane; for the face search of an edge entrance (below) it is the edge
+// axis's, and f's plane may then lie far inside the other block: two crossed
+// logs a few mm apart have face axes a log's width deep, and corners and edge
+// crossings that deep below f are no contact of theirs (they gave sub-contacts
+// 1 m deep between logs that did not touch).
 void faceEntranceContacts(const Prepared& owner, bool ownerIsA, int f, const Prepared& other, double separation,
                           const DetectionSettings& settings, double sinTolerance, Scratch& s,
                           std::vector<SubContact>& out) {
@@ -562,11 +570,17 @@ void faceEntranceContacts(const Prepared& owner, bool ownerIsA, int f, const Pre
 		return distances[v];
 	};
 
-	// Corners of the other block on the face.
+	// Corners of the other block on the face, none deeper below its plane than
+	// the pair's penetration (to the length tolerance): for a face entrance
+	// every corner is at least `separation` above the plane, so this bound only
+	// acts for an edge entrance, where a corner below f's plane of a pair that
+	// does not overlap lies past another face of f's block (its gap would have
+	// the wrong sign).
+	const double lowest = std::min(separation, 0.0) - settings.lengthTolerance;
 	std::vector<int>& used = s.used;
 	used.clear();
 	for (int v : other.vertexList) {
-		if (distance(v) > reach) continue;
+		if (distance(v) > reach || distance(v) < lowest) continue;
 		if (!projectionNearFace(owner, f, other.corner(v), reach)) continue;
 		out.push_back(vertexFaceContact(!ownerIsA, other, v, owner, f));
 		used.push_back(v);
@@ -642,16 +656,16 @@ void faceEntranceContacts(const Prepared& owner, bool ownerIsA, int f, const Pre
 // crossing alone that corner would enter the other block unopposed in the
 // step. What the face finds at the crossing itself (the same edge pair, or a
 // corner or crossing within the corner merge distance of it) is the crossing's
-// contact and is left out.
-void otherFeaturesOfEdgeEntrance(const Prepared& a, const Prepared& b, const FaceCandidate& face,
+// contact and is left out. `separation` is the edge axis's (the pair's).
+void otherFeaturesOfEdgeEntrance(const Prepared& a, const Prepared& b, const FaceCandidate& face, double separation,
                                  const DetectionSettings& settings, double sinTolerance, Scratch& s,
                                  std::vector<SubContact>& out) {
 	const SubContact crossing = out.front();
 	const std::size_t first = out.size();
 	if (face.feature.kind == EntranceFeature::FaceOfA)
-		faceEntranceContacts(a, true, face.feature.feature, b, face.separation, settings, sinTolerance, s, out);
+		faceEntranceContacts(a, true, face.feature.feature, b, separation, settings, sinTolerance, s, out);
 	else
-		faceEntranceContacts(b, false, face.feature.feature, a, face.separation, settings, sinTolerance, s, out);
+		faceEntranceContacts(b, false, face.feature.feature, a, separation, settings, sinTolerance, s, out);
 	const double merge = std::max(settings.cornerMergeDistance, settings.lengthTolerance);
 	const auto sameAsCrossing = [&](const SubContact& c) {
 		if (c.kind == ContactKind::EdgeEdge) {
@@ -747,7 +761,7 @@ void prepareSubUnits(Prepared& p, const LinkedSubUnits* linked, int slot, Scratc
 		p.vertexLinked = nullptr;
 		return;
 	}
-	const auto list = [](const std::vector<int>& v) { return Indices{v.data(), static_cast<int>(v.size())}; };
+	const auto list = [](const SubUnitList& v) { return Indices{v.begin(), static_cast<int>(v.size())}; };
 	p.vertexList = list(linked->vertices[slot]);
 	p.edgeList = list(linked->edges[slot]);
 	p.faceList = list(linked->faces[slot]);
@@ -755,6 +769,19 @@ void prepareSubUnits(Prepared& p, const LinkedSubUnits* linked, int slot, Scratc
 	vertexMark.assign(corners, 0);
 	for (int v : linked->vertices[slot]) vertexMark[v] = 1;
 	p.vertexLinked = vertexMark.data();
+}
+
+// Whether the pair's previous entrance feature (if any) is among the sub-units
+// the pair may use.
+bool previousLinked(const Prepared& a, const Prepared& b, const EntranceFeature& previous) {
+	const auto has = [](const Indices& list, int x) { return std::binary_search(list.begin(), list.end(), x); };
+	switch (previous.kind) {
+		case EntranceFeature::FaceOfA: return has(a.faceList, previous.feature);
+		case EntranceFeature::FaceOfB: return has(b.faceList, previous.feature);
+		case EntranceFeature::EdgePair: return has(a.edgeList, previous.feature) && has(b.edgeList, previous.other);
+		case EntranceFeature::None: return true;
+	}
+	return true;
 }
 
 }  // namespace
@@ -883,6 +910,15 @@ std::optional<PairContacts> detectPairContacts(const BlockGeometry& blockA, cons
 		}
 	}
 
+	// The same bound holds for the entrance itself, which may be the previous
+	// one kept by hysteresis a little deeper than the best axis; and a
+	// previous entrance that is not linked could have been kept by the full
+	// search: both go to the full search too.
+	if (linked && (!(separation >= -0.5 * d0) || !previousLinked(a, b, previous))) {
+		++work->fullSearches;
+		return detectPairContacts(blockA, blockB, settings, previous, nullptr, work);
+	}
+
 	// 3. Sub-contacts.
 	PairContacts out;
 	out.contacts.reserve(8);
@@ -892,8 +928,8 @@ std::optional<PairContacts> detectPairContacts(const BlockGeometry& blockA, cons
 		if (c) {
 			out.normal = (previousEdge.valid && entrance == previous) ? previousEdge.normal : bestEdge.normal;
 			out.contacts.push_back(*c);
-			otherFeaturesOfEdgeEntrance(a, b, chooseFace(faces, a, b, tol, previous), settings, sinTolerance, s,
-			                            out.contacts);
+			otherFeaturesOfEdgeEntrance(a, b, chooseFace(faces, a, b, tol, previous), separation, settings,
+			                            sinTolerance, s, out.contacts);
 		} else {
 			const FaceCandidate& f = chooseFace(faces, a, b, tol, previous);
 			entrance = f.feature;

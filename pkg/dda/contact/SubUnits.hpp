@@ -7,17 +7,36 @@
 #include "dda/geometry/ConvexPolyhedron.hpp"
 
 #include <array>
+#include <cstddef>
 #include <vector>
 
 namespace dda {
 
+// A read-only view of sorted, unique sub-unit indices owned by the broad
+// phase (valid until its next findPairs): many pairs share one block's list.
+class SubUnitList {
+public:
+	SubUnitList() = default;
+	explicit SubUnitList(const std::vector<int>& indices)
+	    : first_(indices.data()), count_(static_cast<int>(indices.size())) {}
+	const int* begin() const { return first_; }
+	const int* end() const { return first_ + count_; }
+	std::size_t size() const { return static_cast<std::size_t>(count_); }
+	bool empty() const { return count_ == 0; }
+	int operator[](std::size_t k) const { return first_[k]; }
+
+private:
+	const int* first_ = nullptr;
+	int count_ = 0;
+};
+
 // Indices into the blocks' shapes: [0] of the pair's first block (A), [1] of
 // the second (B), each sorted and unique.
 struct LinkedSubUnits {
-	std::array<std::vector<int>, 2> vertices, edges, faces;
+	std::array<SubUnitList, 2> vertices, edges, faces;
 	// The paper's "sub-unit loops" of the pair: Va x Fb + Vb x Fa + Ea x Eb.
 	long subUnitPairs() const {
-		const auto n = [](const std::vector<int>& v) { return static_cast<long>(v.size()); };
+		const auto n = [](const SubUnitList& v) { return static_cast<long>(v.size()); };
 		return n(vertices[0]) * n(faces[1]) + n(vertices[1]) * n(faces[0]) + n(edges[0]) * n(edges[1]);
 	}
 };
