@@ -55,7 +55,10 @@ void DESSCollider::findPairs(const std::vector<Block>& blocks, double contactDis
 	stats = BroadPhaseStatistics{};
 	const int n = static_cast<int>(blocks.size());
 	const double margin = kBroadPhaseMarginFactor * contactDistance;
-	const double searchMargin = margin * (1 + kVerletSkinFactor);
+	// A D-box is the d0-box widened by the skin: it contains the d0-box
+	// exactly (x - skin <= x and x + skin >= x in floats), which is all the
+	// cache relies on.
+	const double skin = margin * kVerletSkinFactor;
 	boxes_.resize(n);
 	for (int b = 0; b < n; ++b) {
 		Eigen::AlignedBox3d box;
@@ -88,9 +91,7 @@ void DESSCollider::findPairs(const std::vector<Block>& blocks, double contactDis
 			searchedBoxes_.resize(n);
 			searchedFixed_.resize(n);
 			for (int b = 0; b < n; ++b) {
-				Eigen::AlignedBox3d box;
-				for (const Vector3& x : blocks[b].vertices) box.extend(x);
-				searchedBoxes_[b] = widened(box, searchMargin);
+				searchedBoxes_[b] = widened(boxes_[b], skin);
 				searchedFixed_[b] = blocks[b].fixed;
 			}
 			stats.shellTests = sweep(blocks, searchedBoxes_, cached_);
@@ -101,11 +102,7 @@ void DESSCollider::findPairs(const std::vector<Block>& blocks, double contactDis
 			stats.blocksResearched = static_cast<long>(movers_.size());
 			if (!movers_.empty()) {
 				// Each mover gets a new D-box and is compared with every block.
-				for (int m : movers_) {
-					Eigen::AlignedBox3d box;
-					for (const Vector3& x : blocks[m].vertices) box.extend(x);
-					searchedBoxes_[m] = widened(box, searchMargin);
-				}
+				for (int m : movers_) searchedBoxes_[m] = widened(boxes_[m], skin);
 				kept_.clear();
 				for (const auto& pair : cached_)
 					if (!moved_[pair.first] && !moved_[pair.second]) kept_.push_back(pair);
