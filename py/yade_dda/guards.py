@@ -46,37 +46,34 @@ def _erase(self, id, *args, **kw):
     return _originalErase(self, id, *args, **kw)
 
 
-def _freshScene(keep):
+def _freshScene(bodies=()):
     """Replaces the current DDA scene (its blocks are gone from O.bodies) by an
-    empty one that keeps the pending blocks for which keep(body) is true.
+    empty one that keeps the pending blocks among `bodies` and those made by
+    ddaBlock() but never appended (id < 0).
     (O.tags has no __delitem__, so the token is replaced rather than removed.)"""
     old = _scene.current(create=False)
     if old is None:
         return
+    kept = {id(body) for body in bodies}
     token = uuid.uuid4().hex
     fresh = _scene.DDAScene(token)
-    fresh.pending = [(body, spec) for body, spec in old.pending if keep(body)]
+    fresh.pending = [(body, spec) for body, spec in old.pending if body.id < 0 or id(body) in kept]
     _scene._scenes.pop(old.token, None)
     _scene._scenes[token] = fresh
     O.tags[_scene.TAG] = token
 
 
 def _clear(self, *args, **kw):
-    old = _scene.current(create=False)
-    unappended = set() if old is None else {id(body) for body, _ in old.pending if body.id < 0}
     result = _originalClear(self, *args, **kw)
-    _freshScene(lambda body: id(body) in unappended)
+    _freshScene()
     return result
 
 
 def _replace(self, bodies, *args, **kw):
     bodies = list(bodies)
-    old = _scene.current(create=False)
-    keep = set() if old is None else {id(body) for body, _ in old.pending if body.id < 0}
-    keep.update(id(body) for body in bodies)
     # YADE's replace clears the container in C++ (not through _clear) and appends bodies.
     result = _originalReplace(self, bodies, *args, **kw)
-    _freshScene(lambda body: id(body) in keep)
+    _freshScene(bodies)
     return result
 
 
