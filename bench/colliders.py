@@ -41,6 +41,7 @@ import benchtasks  # noqa: E402  (bench/benchtasks.py: the child-process protoco
 PAPER = ('hexahedra_drop', 'slanted_slide', 'single_block_slide')
 OURS = ('MSC', 'DESS', 'NBS', 'AllPairs')
 YADE_COLLIDERS = ('InsertionSortCollider', 'SpatialQuickSortCollider')
+CACHED = ('MSC:reuseCandidatePairs=1', 'DESS:reuseCandidatePairs=1')   # with the integrator's default pair cache
 GENERATOR_VERSION = 1          # bump when slenderScene changes: cached scene files are keyed by it
 
 # ------------------------------------------------------------------ random slender scenes (numpy only)
@@ -288,6 +289,7 @@ def worker(task):
     blocks, mat, integrator, gravity = sceneSpec(task['scene'], task['outDir'], task['seed'])
     strategy, steps = task['strategy'], task['steps']
     engineName, engineParams = parseStrategy(strategy)
+    reuse = bool(engineParams.pop('reuseCandidatePairs', 0))     # an integrator setting, not the engine's
     kind = 'yade' if strategy in YADE_COLLIDERS else 'dda'
     start = time.perf_counter()
     O.reset()
@@ -301,9 +303,9 @@ def worker(task):
         for points, fixed in blocks:
             O.bodies.append(ddaBlock(points, material=material, fixed=fixed))
         ddaScene.current().resolvePending()          # blocks are in the core: "loaded"
-        # Every strategy searches every step, as in the paper's comparison: DESS's
-        # candidate-pair cache (an effect on demand, measured in bench/effects.py) is off.
-        params = dict(integrator, gravity=gravity, threads=1, reuseCandidatePairs=False)
+        # Every strategy searches every step, as in the paper's comparison, unless the strategy
+        # asks for its pair cache ('MSC:reuseCandidatePairs=1', the integrator's default).
+        params = dict(integrator, gravity=gravity, threads=1, reuseCandidatePairs=reuse)
         collider = ddaColliders.ENGINES[engineName](label='collider', **engineParams)
         O.engines = [collider, DDAIntegrator(label='dda', **params)]
         record['told'] = dict(engines=['%sCollider(%slabel=%r)' % (engineName, ''.join(
@@ -397,7 +399,9 @@ def worker(task):
 
 
 def parseStrategy(strategy):
-    """'MSC' -> ('MSC', {}); 'MSC:segments=6,criticalLength=0.5' -> ('MSC', {'segments': 6, 'criticalLength': 0.5})."""
+    """'MSC' -> ('MSC', {}); 'MSC:segments=6,criticalLength=0.5' -> ('MSC', {'segments': 6, 'criticalLength': 0.5}).
+    The parameter reuseCandidatePairs (0 or 1) goes to DDAIntegrator (the collider's pair cache), the others
+    to the collider engine."""
     name, _, rest = strategy.partition(':')
     params = {}
     for item in filter(None, rest.split(',')):
@@ -423,6 +427,24 @@ def summarise(record):
     return out
 
 
+def combineRounds(summaries):
+    """One summary from the alternating rounds of one (scene, strategy): every mean is the median of
+    the rounds' means (the rounds' own are kept under 'rounds'); memory is the largest round's."""
+    if len(summaries) == 1:
+        return dict(summaries[0], rounds=1)
+    out = dict(summaries[0])
+    keys = set.intersection(*(set(s['mean']) for s in summaries))
+    out['mean'] = {k: statistics.median(s['mean'][k] for s in summaries) for k in keys}
+    out['measuredSteps'] = sum(s['measuredSteps'] for s in summaries)
+    out['detectionMsMedian'] = statistics.median(s['detectionMsMedian'] for s in summaries)
+    out['detectionUsPerBlock'] = 1e3 * out['mean']['detectionMs'] / out['blocks']
+    for key in ('peakMB', 'loadedMB', 'steppingAboveLoadedMB'):
+        out[key] = max(s[key] for s in summaries)
+    out['rounds'] = len(summaries)
+    out['roundDetectionMs'] = [s['mean']['detectionMs'] for s in summaries]
+    return out
+
+
 def _ratio(a, b):
     return a / b if b else None
 
@@ -441,6 +463,16 @@ def evaluateTargets(summaries, slenderScenes, strategies):
     for scene in scenes:
         applies = scene in slenderScenes
         msc, dess, nbs, isc = (by.get((scene, k)) for k in ('MSC', 'DESS', 'NBS', 'InsertionSortCollider'))
+        cachedMsc, cachedDess = (by.get((scene, k + ':reuseCandidatePairs=1')) for k in ('MSC', 'DESS'))
+        if cachedMsc and cachedDess:
+            add(scene, 'MSC detection time / DESS, both with their pair caches', 0.7,
+                _ratio(cachedMsc['mean']['detectionMs'], cachedDess['mean']['detectionMs']),
+                'as a run with the integrator\'s default reuseCandidatePairs=True: a block is searched again '
+                'only when it leaves its cached box', False)
+        if cachedMsc and isc:
+            add(scene, 'MSC with its pair cache / YADE InsertionSortCollider + polyhedra narrow phase', 1 / 20.0,
+                _ratio(cachedMsc['mean']['detectionMs'], isc['mean']['detectionMs']),
+                'both as a user runs them: DDA\'s default pair cache, YADE with the verletDist given', False)
         if msc:
             add(scene, 'MSC candidate pairs / pairs within d0', 2.0,
                 _ratio(msc['mean']['candidatePairs'], msc['mean']['contactPairs']),
@@ -635,9 +667,13 @@ def main():
     parser.add_argument('--quick', action='store_true', help="the paper's scenes and 1,000 blocks, fewer steps")
     parser.add_argument('--sizes', default=None, help='slender scene sizes (default 1000,10000,50000)')
     parser.add_argument('--paper', default=','.join(PAPER), help="paper scenes to run ('' for none)")
-    parser.add_argument('--strategies', default=','.join(('MSC', 'MSC:segments=6') + OURS[1:] + YADE_COLLIDERS),
-                        help="in table order; 'MSC:segments=6' is MSC with those engine parameters (for information: "
-                             "the targets are evaluated on the default 'MSC')")
+    parser.add_argument('--strategies', default=','.join(('MSC', 'MSC:segments=6') + OURS[1:] + CACHED + YADE_COLLIDERS),
+                        help="in table order; 'MSC:segments=6' is MSC with those engine parameters, "
+                             "'MSC:reuseCandidatePairs=1' with its pair cache on (for information: the targets are "
+                             "evaluated on the default 'MSC', which searches every step)")
+    parser.add_argument('--rounds', type=int, default=None,
+                        help='alternating rounds of every strategy on each slender scene, summarised by the median '
+                             'round (default 3 for 1,000 blocks, 1 for larger scenes and the paper scenes)')
     parser.add_argument('--paper-steps', type=int, default=None,
                         help='steps on the paper scenes (default 500 for the drop, 200 for the others; --quick 30)')
     parser.add_argument('--allpairs-max', type=int, default=1000, help='largest n for AllPairs (n^2 / 2 pairs)')
@@ -668,6 +704,7 @@ def main():
                   records=[], summaries=[],
                   skipped={}, failed={}, sceneInfo={}, settings=dict(
                       seed=args.seed, quick=args.quick, verletDist=args.verlet_dist, paperSteps=paperSteps,
+                      rounds=args.rounds if args.rounds is not None else '3 for up to 1,000 blocks, else 1',
                       slenderSteps={str(n): stepsFor.get(n, 4) for n in sizes}, allPairsMax=args.allpairs_max,
                       threads='one per run: OMP_NUM_THREADS=1, DDAIntegrator(threads=1), ompThreads=1 on every '
                               'YADE engine (the equivalent of yade -j1)',
@@ -683,39 +720,54 @@ def main():
     for scene in scenes:
         n = int(scene.split('_')[1]) if scene.startswith('slender_') else None
         steps = paperSteps[scene] if n is None else stepsFor.get(n, 4)
+        rounds = 1 if n is None else args.rounds if args.rounds is not None else 3 if n <= 1000 else 1
+        runnable = []
         for strategy in strategies:
             if strategy == 'AllPairs' and n is not None and n > args.allpairs_max:
                 result['skipped']['%s/%s' % (scene, strategy)] = (
                     '%s on %s: AllPairs hands all n(n-1)/2 = %.3g pairs to the narrow phase each step; run only up '
                     'to %d blocks (--allpairs-max)' % (strategy, scene, n * (n - 1) / 2, args.allpairs_max))
-                continue
-            safe = ''.join(c if c.isalnum() else '_' for c in strategy)
-            task = dict(scene=scene, strategy=strategy, steps=steps, seed=args.seed, outDir=outDir,
-                        verletDist=args.verlet_dist, quietYade=not args.yade_warnings,
-                        result=os.path.join(taskDir, '%s_%s.json' % (scene, safe)))
-            taskFile = os.path.join(taskDir, '%s_%s.task.json' % (scene, safe))
-            t0 = time.time()
-            print('%-20s %-26s %3d steps ... ' % (scene, strategy, steps), end='', flush=True)
-            try:
-                proc, record = benchtasks.runWorker(__file__, task, taskFile, args.timeout, captureStdout=True)
-                why = None if record is not None else 'exit %d: %s' % (proc.returncode, proc.stderr.strip()[-2000:])
-            except subprocess.TimeoutExpired:
-                record, why = None, 'timed out after %.0f s' % args.timeout
-            if record is None:
-                result['failed']['%s/%s' % (scene, strategy)] = why
-                print('FAILED (%s)' % why.splitlines()[-1] if why else 'FAILED', flush=True)
-                continue
-            record['processSeconds'] = time.time() - t0
-            warnings = [line for line in proc.stderr.splitlines() if 'WARN' in line or 'ERROR' in line]
-            if warnings:        # e.g. YADE's per-pair do_intersect notice (with --yade-warnings)
-                record['stderrWarnings'] = dict(count=len(warnings), distinct=sorted(set(warnings))[:5])
-            result['records'].append(record)
-            summary = summarise(record)
-            result['summaries'].append(summary)
-            print('%8.2f ms detection/step, %7.0f candidates, peak %5.0f MB (%4.0f s)%s' % (
-                summary['mean']['detectionMs'], summary['mean']['candidatePairs'], summary['peakMB'],
-                record['processSeconds'],
-                ', %d warnings on stderr' % len(warnings) if warnings else ''), flush=True)
+            else:
+                runnable.append(strategy)
+        # Rounds alternate the strategies, so that a change of the machine's load falls on all of them.
+        perRound = {strategy: [] for strategy in runnable}
+        for round_ in range(rounds):
+            for strategy in runnable:
+                if '%s/%s' % (scene, strategy) in result['failed']:
+                    continue
+                safe = ''.join(c if c.isalnum() else '_' for c in strategy)
+                task = dict(scene=scene, strategy=strategy, steps=steps, seed=args.seed, outDir=outDir,
+                            verletDist=args.verlet_dist, quietYade=not args.yade_warnings,
+                            result=os.path.join(taskDir, '%s_%s.json' % (scene, safe)))
+                taskFile = os.path.join(taskDir, '%s_%s.task.json' % (scene, safe))
+                t0 = time.time()
+                print('%-20s %-30s %3d steps%s ... ' % (scene, strategy, steps,
+                                                         ' round %d/%d' % (round_ + 1, rounds) if rounds > 1 else ''),
+                      end='', flush=True)
+                try:
+                    proc, record = benchtasks.runWorker(__file__, task, taskFile, args.timeout, captureStdout=True)
+                    why = None if record is not None else 'exit %d: %s' % (proc.returncode, proc.stderr.strip()[-2000:])
+                except subprocess.TimeoutExpired:
+                    record, why = None, 'timed out after %.0f s' % args.timeout
+                if record is None:
+                    result['failed']['%s/%s' % (scene, strategy)] = why
+                    print('FAILED (%s)' % why.splitlines()[-1] if why else 'FAILED', flush=True)
+                    continue
+                record['processSeconds'] = time.time() - t0
+                record['round'] = round_
+                warnings = [line for line in proc.stderr.splitlines() if 'WARN' in line or 'ERROR' in line]
+                if warnings:        # e.g. YADE's per-pair do_intersect notice (with --yade-warnings)
+                    record['stderrWarnings'] = dict(count=len(warnings), distinct=sorted(set(warnings))[:5])
+                result['records'].append(record)
+                summary = summarise(record)
+                perRound[strategy].append(summary)
+                print('%8.2f ms detection/step, %7.0f candidates, peak %5.0f MB (%4.0f s)%s' % (
+                    summary['mean']['detectionMs'], summary['mean']['candidatePairs'], summary['peakMB'],
+                    record['processSeconds'],
+                    ', %d warnings on stderr' % len(warnings) if warnings else ''), flush=True)
+        for strategy in runnable:
+            if perRound[strategy] and '%s/%s' % (scene, strategy) not in result['failed']:
+                result['summaries'].append(combineRounds(perRound[strategy]))
     # consistency: every DDA strategy must find the same contact pairs
     consistency = {}
     for scene in scenes:
@@ -729,6 +781,10 @@ def main():
     result['targets'] = evaluateTargets(result['summaries'], [s for s in scenes if s.startswith('slender_')],
                                         strategies)
     result['notes'] = [
+        'Slender scenes of up to 1,000 blocks run in alternating rounds (settings.rounds): each summary is the '
+        'median of its rounds\' means (roundDetectionMs), every round in records[] (record.round).',
+        'Strategies ending in :reuseCandidatePairs=1 run with the integrator\'s default pair cache (a block is '
+        'searched again only when it leaves its cached box); the others search every step.',
         'Means are over the steps after the first; the first step (shell construction, first full sort, YADE '
         'creating every interaction) is under summaries[].firstStep and records[].perStep[0].',
         'DDA: broadMs/narrowMs from yade_dda.stats()["time"]; candidatePairs = block pairs from the broad phase '

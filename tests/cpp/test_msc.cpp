@@ -160,6 +160,33 @@ TEST(MSCCollider, FindsTheAllPairsContactSet) {
 	}
 }
 
+TEST(MSCCollider, SparseAndDenseGridsFindTheSameContacts) {
+	// The grid's cells are keyed by index (counting sort) in a compact domain
+	// and by packed coordinates when a far block makes the domain huge; both
+	// give the all-pairs contact set and the same pairs among the other blocks.
+	const std::vector<Block> compact = blocksOf(randomMscScene(120, 5));
+	World farWorld = randomMscScene(120, 5);
+	farWorld.addBlock(orientedBox(Vector3(4e4, -3e4, 5e4), Vector3(0.1, 0.1, 0.1), Eigen::Matrix3d::Identity()),
+	                  Material(), false);
+	const std::vector<Block> spread = blocksOf(farWorld);
+	for (double d0 : {0.0, 0.05, 0.5}) {
+		MSCCollider dense, sparse;
+		std::vector<std::pair<int, int>> densePairs, sparsePairs;
+		BroadPhaseStatistics stats;
+		dense.findPairs(compact, d0, densePairs, stats);
+		dense.setPairReuse(false);
+		sparse.setPairReuse(false);
+		dense.findPairs(compact, d0, densePairs, stats);
+		EXPECT_TRUE(dense.denseGrid());
+		sparse.findPairs(spread, d0, sparsePairs, stats);
+		EXPECT_FALSE(sparse.denseGrid());
+		EXPECT_EQ(densePairs, sparsePairs) << "d0 " << d0;  // the far block meets nothing
+		AllPairsCollider all;
+		EXPECT_TRUE(contactSet(sparse, spread, d0) == contactSet(all, spread, d0)) << "d0 " << d0;
+		EXPECT_TRUE(contactSet(dense, compact, d0) == contactSet(all, compact, d0)) << "d0 " << d0;
+	}
+}
+
 TEST(MSCCollider, LinksEveryFeatureOfTheContacts) {
 	// Random scenes, deep overlaps included (the design argument covers
 	// penetrations up to d0 / 2; deeper ones hold on these scenes too).

@@ -288,34 +288,67 @@ long MSCCollider::gridSearch(const std::vector<Block>& blocks, const std::vector
 	// least 1/kMaxCellsPerAxis of the domain). A shell enters every cell it
 	// overlaps; one spanning more than kMaxCellsPerShell cells (a floor, a
 	// block much larger than the rest) is compared with every shell instead.
-	// Two shells are compared in one cell only: the cell holding the lower
-	// corner of their boxes' intersection.
+	// Two shells are compared in one cell only: the cell of the lower corner
+	// of their boxes' intersection. cellOf is monotone in each coordinate, so
+	// that cell is the componentwise max of the two shells' lowest cells, and
+	// lies in both shells' ranges when the boxes meet (the test is on the
+	// integer ranges computed once per shell).
 	const Vector3 origin = domain.min();
 	const double cell = std::max(sideSum / shellTotal, domain.sizes().maxCoeff() / kMaxCellsPerAxis);
 	const auto cellOf = [&](const Vector3& x) {
 		return ((x - origin) / cell).array().floor().cast<long>().min(kMaxCellsPerAxis - 1).max(0).eval();
 	};
-	const auto key = [](const Eigen::Array<long, 3, 1>& c) {
-		return static_cast<std::uint64_t>(c.x()) << 42 | static_cast<std::uint64_t>(c.y()) << 21 |
-		       static_cast<std::uint64_t>(c.z());
+	const Cell dims = cellOf(domain.max()) + 1;
+	cellLow_.resize(shellTotal);
+	cellHigh_.resize(shellTotal);
+	oversize_.clear();
+	isOversize_.assign(shellTotal, 0);
+	std::size_t entries = 0;
+	for (int s = 0; s < shellTotal; ++s) {
+		cellLow_[s] = cellOf(boxes[s].min());
+		cellHigh_[s] = cellOf(boxes[s].max());
+		const long span = (cellHigh_[s] - cellLow_[s] + 1).prod();
+		if (span > kMaxCellsPerShell) {
+			oversize_.push_back(s);
+			isOversize_[s] = 1;
+		} else {
+			entries += static_cast<std::size_t>(span);
+		}
+	}
+	// Cell keys: the cell's index in the domain's grid when the grid has at
+	// most kDenseCellsPerEntry x the entries (then sorted by counting), else
+	// the three coordinates packed in 21 bits each (sorted by comparison).
+	const double denseCells = static_cast<double>(dims.x()) * static_cast<double>(dims.y()) * static_cast<double>(dims.z());
+	const bool dense = denseCells <= kDenseCellsPerEntry * static_cast<double>(entries) + kDenseCellsFloor;
+	denseGrid_ = dense;
+	const auto key = [&](const Cell& c) {
+		return dense ? static_cast<std::uint64_t>((c.x() * dims.y() + c.y()) * dims.z() + c.z())
+		             : static_cast<std::uint64_t>(c.x()) << 42 | static_cast<std::uint64_t>(c.y()) << 21 |
+		                   static_cast<std::uint64_t>(c.z());
 	};
 	cellEntries_.clear();
-	oversize_.clear();
+	cellEntries_.reserve(entries);
 	for (int s = 0; s < shellTotal; ++s) {
-		const Eigen::Array<long, 3, 1> lo = cellOf(boxes[s].min()), hi = cellOf(boxes[s].max());
-		const Eigen::Array<long, 3, 1> span = hi - lo + 1;
-		if (span.prod() > kMaxCellsPerShell) {
-			oversize_.push_back(s);
-			continue;
-		}
+		if (isOversize_[s]) continue;
+		const Cell& lo = cellLow_[s];
+		const Cell& hi = cellHigh_[s];
 		for (long i = lo.x(); i <= hi.x(); ++i)
 			for (long j = lo.y(); j <= hi.y(); ++j)
-				for (long k = lo.z(); k <= hi.z(); ++k)
-					cellEntries_.emplace_back(key(Eigen::Array<long, 3, 1>(i, j, k)), s);
+				for (long k = lo.z(); k <= hi.z(); ++k) cellEntries_.emplace_back(key(Cell(i, j, k)), s);
 	}
-	std::sort(cellEntries_.begin(), cellEntries_.end());
-	isOversize_.assign(shellTotal, 0);
-	for (int s : oversize_) isOversize_[s] = 1;
+	if (dense) {
+		// Counting sort by cell, stable (shells ascending within a cell, as
+		// the comparison sort gives).
+		const std::size_t cells = static_cast<std::size_t>(denseCells);
+		cellStart_.assign(cells + 1, 0);
+		for (const auto& entry : cellEntries_) ++cellStart_[entry.first + 1];
+		for (std::size_t c = 0; c < cells; ++c) cellStart_[c + 1] += cellStart_[c];
+		sortedEntries_.resize(cellEntries_.size());
+		for (const auto& entry : cellEntries_) sortedEntries_[cellStart_[entry.first]++] = entry;
+		cellEntries_.swap(sortedEntries_);
+	} else {
+		std::sort(cellEntries_.begin(), cellEntries_.end());
+	}
 
 	long tests = 0;
 	const auto compare = [&](int s, int t) {
@@ -325,18 +358,18 @@ long MSCCollider::gridSearch(const std::vector<Block>& blocks, const std::vector
 		if (!boxes[s].intersects(boxes[t])) return;
 		out.push_back(a < b ? ShellPair{a, b, s, t} : ShellPair{b, a, t, s});
 	};
-	const std::size_t entries = cellEntries_.size();
 	for (std::size_t first = 0; first < entries;) {
 		std::size_t last = first + 1;
 		while (last < entries && cellEntries_[last].first == cellEntries_[first].first) ++last;
 		const std::uint64_t here = cellEntries_[first].first;
-		for (std::size_t p = first; p < last; ++p)
+		for (std::size_t p = first; p < last; ++p) {
+			const int s = cellEntries_[p].second;
 			for (std::size_t q = p + 1; q < last; ++q) {
-				const int s = cellEntries_[p].second, t = cellEntries_[q].second;
-				const Vector3 low = boxes[s].min().cwiseMax(boxes[t].min());
-				if (key(cellOf(low)) != here) continue;  // compared in another cell
+				const int t = cellEntries_[q].second;
+				if (key(cellLow_[s].max(cellLow_[t])) != here) continue;  // compared in another cell
 				compare(s, t);
 			}
+		}
 		first = last;
 	}
 	for (int s : oversize_)

@@ -69,6 +69,10 @@ public:
 	// every shell rather than entered in each.
 	static constexpr long kMaxCellsPerAxis = 1 << 20;
 	static constexpr long kMaxCellsPerShell = 64;
+	// The grid's cells are keyed by their index (and sorted by counting) when
+	// there are at most this x the entries plus kDenseCellsFloor cells.
+	static constexpr double kDenseCellsPerEntry = 4;
+	static constexpr double kDenseCellsFloor = 4096;
 	// A frame is used when its three unit face normals span at least this
 	// volume (|det|, 1 for orthogonal ones) when chosen, and half of it at each
 	// step (a strained block); else the coordinate axes are its frame [-].
@@ -115,6 +119,10 @@ public:
 	long totalShellUpdates() const { return totalShellUpdates_; }
 	// Topology builds (block covers) since construction.
 	long coverBuilds() const { return coverBuilds_; }
+
+	// Whether the last grid search keyed its cells densely (counting sort)
+	// or by packed coordinates (a sparse domain; diagnostics and tests).
+	bool denseGrid() const { return denseGrid_; }
 
 	// The faces whose normals make a block's frame, or -1s (coordinate axes).
 	const std::array<int, 3>& frameFaces(int block) const { return covers_.at(block).frameFaces; }
@@ -216,7 +224,11 @@ private:
 	std::vector<int> pointStart_;
 	std::vector<int> shellBlock_, shellIndex_;  // per flat shell
 	std::vector<Eigen::AlignedBox3d> widened_;
-	std::vector<std::pair<std::uint64_t, int>> cellEntries_;  // (cell key, shell), sorted
+	using Cell = Eigen::Array<long, 3, 1>;  // a subspace's integer coordinates
+	std::vector<Cell> cellLow_, cellHigh_;   // per flat shell: the cells its box spans
+	std::vector<std::pair<std::uint64_t, int>> cellEntries_, sortedEntries_;  // (cell key, shell), sorted
+	std::vector<std::size_t> cellStart_;     // counting sort: first entry of each cell
+	bool denseGrid_ = false;
 	std::vector<int> oversize_;   // shells compared with every shell
 	std::vector<char> isOversize_;
 	std::vector<ShellPair> hits_;
