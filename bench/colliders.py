@@ -367,6 +367,9 @@ def worker(task):
                     row[key] = s[key]
             for key in ('assembly', 'solve', 'update', 'sync'):
                 row[key + 'Ms'] = 1e3 * s['time'][key]
+            if 'memory' in s:      # heap the broad phase and the contacts hold [MB]
+                row['colliderMB'] = s['memory']['collider'] / 2.0 ** 20
+                row['contactsMB'] = s['memory']['contacts'] / 2.0 ** 20
             if step == 0:        # the scene must not start interpenetrating: smallest sub-contact gap
                 gaps = [c[9] for c in ddaScene.current().core.contacts()]
                 record['firstStepGaps'] = dict(min=min(gaps) if gaps else None, negative=sum(1 for g in gaps if g < 0),
@@ -500,6 +503,11 @@ def evaluateTargets(summaries, slenderScenes, strategies):
             add(scene, 'MSC peak RSS / YADE InsertionSortCollider peak RSS', 0.5, _ratio(msc['peakMB'], isc['peakMB']),
                 '"well under" read as at most half; whole-process peak RSS (as the issue\'s 740 MB), each run in its '
                 'own process', applies)
+            if 'colliderMB' in msc['mean']:
+                add(scene, 'MSC detection heap (collider + contacts) / YADE ISC memory added by stepping', None,
+                    _ratio(msc['mean']['colliderMB'] + msc['mean']['contactsMB'], isc['steppingAboveLoadedMB']),
+                    'information: stats()["memory"] (the arrays MSC and the contact store hold) against what '
+                    'YADE\'s collider, interactions and laws added to its RSS', False)
             add(scene, 'MSC / YADE ISC memory added by stepping (peak - loaded)', None,
                 _ratio(msc['steppingAboveLoadedMB'], isc['steppingAboveLoadedMB']),
                 'information: DDA: collider, contacts and the solver; YADE: collider and interactions', False)
@@ -797,6 +805,8 @@ def main():
         '(Ig2_Polyhedra_Polyhedra_PolyhedraGeom with CGAL, plus Ip2 and the Volumetric law, timed together); '
         'candidatePairs = len(O.interactions) (unwidened box overlaps), realInteractions = countReal() '
         '(overlapping volumes). YADE has no contact distance, so it has no "pairs within d0" of its own.',
+        'colliderMB and contactsMB (DDA): stats()["memory"], the heap the broad phase and the contact store '
+        '(with the previous step\'s contacts, kept for their history) hold after the detection.',
         'Memory: each run is its own process. memory.bareYadeMB = RSS after importing YADE and yade_dda; '
         'loadedMB = RSS with the scene loaded (bodies in O.bodies, DDA blocks in the core) but not stepped; '
         'peakWhileSteppingMB = VmHWM after resetting it at load (clear_refs), so steppingAboveLoadedMB is what '

@@ -258,6 +258,10 @@ py::dict lastStep(const SceneLink& s) {
 	d["subUnitPairs"] = st.subUnitPairs;
 	d["subUnitTests"] = st.subUnitTests;
 	d["fullSearchPairs"] = st.fullSearchPairs;
+	py::dict memory;
+	memory["collider"] = st.colliderBytes;
+	memory["contacts"] = st.contactBytes;
+	d["memory"] = memory;
 	d["contactPairs"] = st.contactPairs;
 	d["contacts"] = st.contacts;
 	d["closedContacts"] = st.closedContacts;

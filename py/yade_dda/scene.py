@@ -182,6 +182,9 @@ def stats():
     converge), ``openCloseFailures`` (cumulative steps accepted unconverged),
     ``maxPenetration`` [m] (deepest closed contact), ``components`` and
     ``largestComponent`` (independent systems solved, blocks in the largest).
+    ``memory``: heap bytes held after the detection: ``collider`` (the broad
+    phase's arrays: boxes, shells, grid, caches) and ``contacts`` (the contact
+    store with the previous step's contacts, and the per-pair results).
     ``time``: wall seconds per phase: broadPhase, narrowPhase, assembly,
     solve, update, core, sync. ``syncedBodies`` and ``syncs``
     (bodies written by the last sync, syncs so far), ``syncTimeTotal`` and

@@ -573,3 +573,29 @@ TEST(MSCCollider, LinkedNarrowPhaseEqualsTheFullSearchAndFallsBackWhenDeep) {
 	}
 	EXPECT_GT(fullSearches, 0);
 }
+
+TEST(MSCCollider, MemoryStatisticsCountTheArraysHeld) {
+	// stats' colliderBytes and contactBytes hold at least the arrays every
+	// strategy must keep (a box per block or shell; a Contact per sub-contact)
+	// and MSC's shells cost more than DESS's single boxes.
+	const auto run = [](std::unique_ptr<Collider> collider) {
+		World world = randomMscScene(120, 9);
+		world.setCollider(std::move(collider));
+		IntegratorSettings settings;
+		settings.maxTimeStep = 1e-4;
+		world.step(settings);
+		return world.lastStep();
+	};
+	const StepStatistics dess = run(std::make_unique<DESSCollider>());
+	const StepStatistics msc = run(std::make_unique<MSCCollider>());
+	const StepStatistics nbs = run(std::make_unique<NBSCollider>());
+	ASSERT_GT(dess.contacts, 10);
+	for (const StepStatistics* s : {&dess, &msc, &nbs}) {
+		EXPECT_GE(s->contactBytes, static_cast<long>(s->contacts * sizeof(Contact)));
+		EXPECT_LT(s->contactBytes, static_cast<long>(s->contacts * sizeof(Contact)) * 20 + (1 << 20));
+	}
+	EXPECT_GE(dess.colliderBytes, static_cast<long>(dess.blocks * sizeof(Eigen::AlignedBox3d)));
+	EXPECT_GE(msc.colliderBytes, static_cast<long>(msc.shells * 2 * sizeof(Eigen::AlignedBox3d)));
+	EXPECT_GT(msc.colliderBytes, dess.colliderBytes);
+	EXPECT_GE(nbs.colliderBytes, static_cast<long>(nbs.blocks * (sizeof(Vector3) + sizeof(double))));
+}

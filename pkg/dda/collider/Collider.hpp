@@ -65,7 +65,16 @@ public:
 	// Whether the strategy may reuse candidates of earlier calls (strategies
 	// without a cache ignore it). The pairs returned never depend on it.
 	virtual void setPairReuse(bool /*reuse*/) {}
+	// Heap bytes the strategy holds between calls (its arrays' capacities:
+	// boxes, shells, grid, caches, linked lists) [bytes], for stats().
+	virtual std::size_t memoryBytes() const { return 0; }
 };
+
+// Heap bytes of a vector's storage (its capacity) [bytes].
+template <class T>
+std::size_t capacityBytes(const std::vector<T>& v) {
+	return v.capacity() * sizeof(T);
+}
 
 // Every pair of blocks that are not both fixed: O(n^2), the reference.
 class AllPairsCollider : public Collider {
@@ -107,6 +116,10 @@ public:
 	void findPairs(const std::vector<Block>& blocks, double contactDistance, std::vector<std::pair<int, int>>& pairs,
 	               BroadPhaseStatistics& stats) override;
 	void setPairReuse(bool reuse) override;
+	std::size_t memoryBytes() const override {
+		return capacityBytes(boxes_) + capacityBytes(order_) + capacityBytes(searchedBoxes_) + capacityBytes(cached_) +
+		       capacityBytes(kept_) + capacityBytes(searchedFixed_) + capacityBytes(moved_) + capacityBytes(movers_);
+	}
 
 private:
 	// Sort-and-sweep of `boxes` (pairs not both fixed) into `pairs`, sorted;
@@ -136,6 +149,9 @@ public:
 	const char* name() const override { return "NBS"; }
 	void findPairs(const std::vector<Block>& blocks, double contactDistance, std::vector<std::pair<int, int>>& pairs,
 	               BroadPhaseStatistics& stats) override;
+	std::size_t memoryBytes() const override {
+		return capacityBytes(centres_) + capacityBytes(radii_) + capacityBytes(cellOf_);
+	}
 
 private:
 	std::vector<Vector3> centres_;

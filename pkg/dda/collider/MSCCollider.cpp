@@ -319,37 +319,14 @@ long MSCCollider::gridSearch(const std::vector<Block>& blocks, const std::vector
 	// most kDenseCellsPerEntry x the entries (then sorted by counting), else
 	// the three coordinates packed in 21 bits each (sorted by comparison).
 	const double denseCells = static_cast<double>(dims.x()) * static_cast<double>(dims.y()) * static_cast<double>(dims.z());
-	const bool dense = denseCells <= kDenseCellsPerEntry * static_cast<double>(entries) + kDenseCellsFloor;
+	const bool dense = denseCells <= kDenseCellsPerEntry * static_cast<double>(entries) + kDenseCellsFloor &&
+	                   entries < std::numeric_limits<std::uint32_t>::max();
 	denseGrid_ = dense;
 	const auto key = [&](const Cell& c) {
 		return dense ? static_cast<std::uint64_t>((c.x() * dims.y() + c.y()) * dims.z() + c.z())
 		             : static_cast<std::uint64_t>(c.x()) << 42 | static_cast<std::uint64_t>(c.y()) << 21 |
 		                   static_cast<std::uint64_t>(c.z());
 	};
-	cellEntries_.clear();
-	cellEntries_.reserve(entries);
-	for (int s = 0; s < shellTotal; ++s) {
-		if (isOversize_[s]) continue;
-		const Cell& lo = cellLow_[s];
-		const Cell& hi = cellHigh_[s];
-		for (long i = lo.x(); i <= hi.x(); ++i)
-			for (long j = lo.y(); j <= hi.y(); ++j)
-				for (long k = lo.z(); k <= hi.z(); ++k) cellEntries_.emplace_back(key(Cell(i, j, k)), s);
-	}
-	if (dense) {
-		// Counting sort by cell, stable (shells ascending within a cell, as
-		// the comparison sort gives).
-		const std::size_t cells = static_cast<std::size_t>(denseCells);
-		cellStart_.assign(cells + 1, 0);
-		for (const auto& entry : cellEntries_) ++cellStart_[entry.first + 1];
-		for (std::size_t c = 0; c < cells; ++c) cellStart_[c + 1] += cellStart_[c];
-		sortedEntries_.resize(cellEntries_.size());
-		for (const auto& entry : cellEntries_) sortedEntries_[cellStart_[entry.first]++] = entry;
-		cellEntries_.swap(sortedEntries_);
-	} else {
-		std::sort(cellEntries_.begin(), cellEntries_.end());
-	}
-
 	long tests = 0;
 	const auto compare = [&](int s, int t) {
 		const int a = shellBlock_[s], b = shellBlock_[t];
@@ -358,19 +335,53 @@ long MSCCollider::gridSearch(const std::vector<Block>& blocks, const std::vector
 		if (!boxes[s].intersects(boxes[t])) return;
 		out.push_back(a < b ? ShellPair{a, b, s, t} : ShellPair{b, a, t, s});
 	};
-	for (std::size_t first = 0; first < entries;) {
-		std::size_t last = first + 1;
-		while (last < entries && cellEntries_[last].first == cellEntries_[first].first) ++last;
-		const std::uint64_t here = cellEntries_[first].first;
+	// The shells of cell `here`: cellShells_[first, last), ascending.
+	const auto scanCell = [&](std::uint64_t here, std::size_t first, std::size_t last) {
 		for (std::size_t p = first; p < last; ++p) {
-			const int s = cellEntries_[p].second;
+			const int s = cellShells_[p];
 			for (std::size_t q = p + 1; q < last; ++q) {
-				const int t = cellEntries_[q].second;
+				const int t = cellShells_[q];
 				if (key(cellLow_[s].max(cellLow_[t])) != here) continue;  // compared in another cell
 				compare(s, t);
 			}
 		}
-		first = last;
+	};
+	const auto forEachCellOf = [&](int s, const auto& visit) {
+		const Cell& lo = cellLow_[s];
+		const Cell& hi = cellHigh_[s];
+		for (long i = lo.x(); i <= hi.x(); ++i)
+			for (long j = lo.y(); j <= hi.y(); ++j)
+				for (long k = lo.z(); k <= hi.z(); ++k) visit(key(Cell(i, j, k)));
+	};
+	cellShells_.resize(entries);
+	if (dense) {
+		// Counting sort: count per cell, prefix sums (cellStart_[c + 1] = end
+		// of cell c), then shells placed from the last down, so each cell's
+		// shells ascend and cellStart_[c] ends at the cell's first entry.
+		const std::size_t cells = static_cast<std::size_t>(denseCells);
+		cellStart_.assign(cells + 1, 0);
+		for (int s = 0; s < shellTotal; ++s)
+			if (!isOversize_[s]) forEachCellOf(s, [&](std::uint64_t c) { ++cellStart_[c + 1]; });
+		for (std::size_t c = 0; c < cells; ++c) cellStart_[c + 1] += cellStart_[c];
+		for (int s = shellTotal - 1; s >= 0; --s)
+			if (!isOversize_[s]) forEachCellOf(s, [&](std::uint64_t c) { cellShells_[--cellStart_[c + 1]] = s; });
+		// Now cellStart_[c + 1] is the start of cell c; cell c is [cellStart_[c + 1], cellStart_[c + 2]).
+		cellStart_.push_back(static_cast<std::uint32_t>(entries));
+		for (std::size_t c = 0; c < cells; ++c)
+			if (cellStart_[c + 2] - cellStart_[c + 1] > 1) scanCell(c, cellStart_[c + 1], cellStart_[c + 2]);
+	} else {
+		cellEntries_.clear();
+		cellEntries_.reserve(entries);
+		for (int s = 0; s < shellTotal; ++s)
+			if (!isOversize_[s]) forEachCellOf(s, [&](std::uint64_t c) { cellEntries_.emplace_back(c, s); });
+		std::sort(cellEntries_.begin(), cellEntries_.end());
+		for (std::size_t p = 0; p < entries; ++p) cellShells_[p] = cellEntries_[p].second;
+		for (std::size_t first = 0; first < entries;) {
+			std::size_t last = first + 1;
+			while (last < entries && cellEntries_[last].first == cellEntries_[first].first) ++last;
+			scanCell(cellEntries_[first].first, first, last);
+			first = last;
+		}
 	}
 	for (int s : oversize_)
 		for (int t = 0; t < shellTotal; ++t)
@@ -560,6 +571,26 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 		stats.subUnitPairs += out.subUnitPairs();
 	}
 	stats.candidatePairs = static_cast<long>(pairs.size());
+}
+
+std::size_t MSCCollider::memoryBytes() const {
+	std::size_t bytes = capacityBytes(covers_) + capacityBytes(frames_) + capacityBytes(boxes_) +
+	                    capacityBytes(extentLow_) + capacityBytes(extentHigh_) + capacityBytes(points_) +
+	                    capacityBytes(pointStart_) + capacityBytes(shellBlock_) + capacityBytes(shellIndex_) +
+	                    capacityBytes(widened_) + capacityBytes(cellLow_) + capacityBytes(cellHigh_) +
+	                    capacityBytes(cellEntries_) + capacityBytes(cellShells_) + capacityBytes(cellStart_) +
+	                    capacityBytes(oversize_) + capacityBytes(isOversize_) + capacityBytes(hits_) +
+	                    capacityBytes(candidates_) + capacityBytes(linked_) + capacityBytes(searchBoxes_) +
+	                    capacityBytes(cached_) + capacityBytes(kept_) + capacityBytes(searchedFixed_) +
+	                    capacityBytes(moved_) + capacityBytes(movers_) + overrides_.size() * (sizeof(Override) + 48);
+	for (const BlockCover& cover : covers_) {
+		bytes += capacityBytes(cover.shells) + capacityBytes(cover.vertexShells) + capacityBytes(cover.edgeShells) +
+		         capacityBytes(cover.faceShells) + capacityBytes(cover.linkedSets);
+		for (const Shell& shell : cover.shells) bytes += capacityBytes(shell.corners) + capacityBytes(shell.divisions);
+		for (const LinkedSet& set : cover.linkedSets)
+			bytes += capacityBytes(set.vertices) + capacityBytes(set.edges) + capacityBytes(set.faces);
+	}
+	return bytes;
 }
 
 }  // namespace dda

@@ -97,6 +97,7 @@ public:
 	               BroadPhaseStatistics& stats) override;
 	const LinkedSubUnits* linked(int pairIndex) const override;
 	void setPairReuse(bool reuse) override;
+	std::size_t memoryBytes() const override;
 
 	// The scene's cover (what yade_dda's MSCCollider engine sets): critical
 	// length [m] >= 0, 0 = criticalLengthFactor x each block's size; segments
@@ -226,8 +227,9 @@ private:
 	std::vector<Eigen::AlignedBox3d> widened_;
 	using Cell = Eigen::Array<long, 3, 1>;  // a subspace's integer coordinates
 	std::vector<Cell> cellLow_, cellHigh_;   // per flat shell: the cells its box spans
-	std::vector<std::pair<std::uint64_t, int>> cellEntries_, sortedEntries_;  // (cell key, shell), sorted
-	std::vector<std::size_t> cellStart_;     // counting sort: first entry of each cell
+	std::vector<std::pair<std::uint64_t, int>> cellEntries_;  // sparse keys: (cell key, shell), sorted
+	std::vector<int> cellShells_;             // every cell's shells, cell after cell
+	std::vector<std::uint32_t> cellStart_;    // dense keys: where each cell's shells start
 	bool denseGrid_ = false;
 	std::vector<int> oversize_;   // shells compared with every shell
 	std::vector<char> isOversize_;

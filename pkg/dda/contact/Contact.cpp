@@ -135,4 +135,20 @@ void ContactStore::clear() {
 	claimed_.clear();
 }
 
+namespace {
+template <class Map>
+std::size_t mapBytes(const Map& map) {
+	return map.bucket_count() * sizeof(void*) +
+	       map.size() * (sizeof(void*) + sizeof(typename Map::value_type) + sizeof(std::size_t) + 16);
+}
+}  // namespace
+
+std::size_t ContactStore::memoryBytes() const {
+	std::size_t bytes = (current_.capacity() + previous_.capacity()) * sizeof(Contact) + claimed_.capacity() +
+	                    mapBytes(previousIndex_) + mapBytes(byFeature1_) + mapBytes(entrances_) +
+	                    mapBytes(previousEntrances_);
+	for (const auto& entry : byFeature1_) bytes += entry.second.capacity() * sizeof(int);
+	return bytes;
+}
+
 }  // namespace dda

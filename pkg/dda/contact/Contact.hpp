@@ -100,6 +100,10 @@ public:
 	void setEntrance(int a, int b, const EntranceFeature& entrance);
 
 	void clear();
+	// Heap bytes held: both contact arrays' capacities and the hash maps
+	// (buckets, and per entry its node: a pointer, the entry, the cached hash
+	// and malloc's 16-byte header) [bytes].
+	std::size_t memoryBytes() const;
 
 	// Saving (solver/WorldState.cpp): the current contacts and entrance
 	// features are all a store carries into the next step.

@@ -368,6 +368,12 @@ void World::detectContacts(const IntegratorSettings& settings, StepStatistics& s
 	}
 	stats.contacts = static_cast<int>(store_.contacts().size());
 	stats.timeNarrowPhase = secondsSince(phase);
+	stats.colliderBytes = static_cast<long>(collider_->memoryBytes());
+	std::size_t contactBytes = store_.memoryBytes() + capacityBytes(pairs_) + capacityBytes(pairResults_) +
+	                           capacityBytes(pairWork_) + capacityBytes(points_);
+	for (const auto& result : pairResults_)
+		if (result) contactBytes += capacityBytes(result->contacts);
+	stats.contactBytes = static_cast<long>(contactBytes);
 }
 
 void World::buildSystemStructure(int movingBlocks, StepStatistics& stats) {
