@@ -56,7 +56,8 @@ def _tag(name):
 def encodeState(scene):
     """The tag text holding a DDA scene's full state (see the module docstring)."""
     info = dict(token=scene.token, iter=O.iter, steps=scene.core.steps(), bodies=scene.bodyOfBlock,
-                cover=list(scene.cover) if getattr(scene, 'cover', None) is not None else None)
+                cover=list(scene.cover) if getattr(scene, 'cover', None) is not None else None,
+                checked=getattr(scene, 'overlapsChecked', 0))
     infoBytes = json.dumps(info, separators=(',', ':')).encode('utf-8')
     raw = struct.pack('<Q', len(infoBytes)) + infoBytes + scene.core.saveState()
     return FORMAT + ' ' + base64.b64encode(zlib.compress(raw, 1)).decode('ascii')
@@ -132,7 +133,9 @@ def restoreState():
     core = _core.Scene()
     core.loadState(state)
     bodies = info['bodies']
-    if core.steps() != info['steps'] or core.blockCount() != len(bodies):
+    checked = info.get('checked', core.blockCount() if core.steps() > 0 else 0)
+    if (core.steps() != info['steps'] or core.blockCount() != len(bodies) or not isinstance(checked, int)
+            or isinstance(checked, bool) or not 0 <= checked <= len(bodies)):
         raise ValueError("O.tags['%s'] is corrupt: its header and its core state disagree" % STATE_TAG)
     for index, bodyId in enumerate(bodies):
         body = O.bodies[bodyId] if 0 <= bodyId < len(O.bodies) else None
@@ -144,6 +147,13 @@ def restoreState():
     scene.core = core
     scene.bodyOfBlock = list(bodies)
     scene.cover = tuple(info['cover']) if info.get('cover') is not None else None
+    # The blocks the saved scene had already checked for initial overlaps (guards.checkInitialOverlaps)
+    # stay checked: checked again, blocks pressed into each other by their contacts (an impact, a block
+    # sliding into a step) would be refused as overlapping and the run could not resume. Blocks that
+    # entered the core when the scene was saved (pending ones) are still checked at the next step, as
+    # they would have been without the save. States written before this was stored: all blocks of a
+    # scene that has stepped count as checked, none of one that has not.
+    scene.overlapsChecked = checked
     _scene.register(scene)
     O.tags[STATE_TAG] = ''
     return scene

@@ -48,3 +48,15 @@ def state():
                  c.bonded) for c in yade_dda.contacts()]
     return dict(blocks=blocks, contacts=contacts, iter=O.iter, time=float(O.time).hex(), steps=core.steps(),
                 nextDt=float(O.dt).hex())
+
+
+def impact(speed=2.0, engines=()):
+    """A block falling at ``speed`` [m/s] onto a fixed floor, released 1 mm above
+    it: during the impact (the first 8 or so steps at 2 m/s) the contact spring
+    presses it into the floor deeper than the initial-overlap tolerance of
+    blocks entering a scene (guards.checkInitialOverlaps)."""
+    O.reset()
+    material = O.materials.append(wrapper.PolyhedraMat(young=1e8, poisson=0.25, density=2600, frictionAngle=0.5))
+    O.bodies.append(ddaBlock(box(-2, -2, -1, 2, 2, 0), material=material, fixed=True))
+    O.bodies.append(ddaBlock(box(-0.5, -0.5, 0.001, 0.5, 0.5, 1.001), material=material, velocity=(0, 0, -speed)))
+    O.engines = [DDAIntegrator(dt=1e-3, gravity=(0, 0, -9.81), maxDisplacement=0.01)] + list(engines)

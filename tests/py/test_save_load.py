@@ -9,6 +9,7 @@ next dt must equal those of an uninterrupted N + M step run, bit for bit
 (the state is written bit for bit and in container order, so nothing
 changes summation order).
 """
+import ast
 import base64
 import gzip
 import json
@@ -25,7 +26,7 @@ import zlib
 import pytest
 
 import yade_dda
-from yade_dda import O, _core, saveload
+from yade_dda import O, _core, engines, saveload
 from yade_dda import scene as ddaScene
 from yade import wrapper
 
@@ -178,6 +179,55 @@ def test_load_in_a_fresh_process(scene, reference, tmp_path, unwrapped):
     O.save(path)
     out = _child(CHILD_LOAD, here=HERE, path=path, steps=M, unwrapped=unwrapped)
     _compare(_childState(out), reference[1])
+
+
+IMPACT_STEPS = 20
+
+
+def _deepOverlaps():
+    """Pairs of the current scene's blocks pressed into each other deeper than
+    blocks entering a scene may overlap (guards.checkInitialOverlaps, all blocks)."""
+    text = O.engines[0].command
+    _, settings = engines._parse(ast.literal_eval(text[text.index('(') + 1:-1]))
+    return ddaScene.current().core.initialOverlaps(0, [], settings)
+
+
+@pytest.mark.parametrize('how', ['save', 'checkpoint'])
+def test_save_load_during_an_impact(scene, tmp_path, how):
+    """Saved while a falling block is pressed into the floor deeper than blocks
+    entering a scene may overlap, the scene loads and continues bitwise. Its
+    blocks passed the initial-overlap check when they entered; the loaded scene
+    must not check them again as if new (it did: the first step after the load
+    raised, O.run gave RuntimeError 'PyRunner error', and a checkpoint written
+    at such a moment, e.g. by test_checkpoint_survives_sigkill's child, could
+    not be resumed)."""
+    saveload_scene.impact()
+    deep = []
+    for k in range(1, IMPACT_STEPS + 1):
+        O.run(1, True)
+        if _deepOverlaps():
+            deep.append(k)
+    want = saveload_scene.state()
+    assert len(deep) >= 3, 'the scene must press the blocks deeper than the tolerance at several steps: %s' % deep
+    if how == 'save':
+        saved = []
+        for k in deep:
+            saveload_scene.impact()
+            O.run(k, True)
+            path = str(tmp_path / ('impact-%d.yade' % k))
+            O.save(path)
+            saved.append((k, path))
+    else:
+        directory = str(tmp_path / 'ck')
+        saveload_scene.impact(engines=[yade_dda.Checkpoint(period=1, directory=directory, keep=1000, format='.yade')])
+        O.run(IMPACT_STEPS, True)
+        saved = [(k, path) for k, path in saveload.checkpoints(directory) if k in deep]
+        assert len(saved) == len(deep), saved
+    for k, path in saved:
+        O.load(path)
+        assert O.iter == k
+        O.run(IMPACT_STEPS - k, True)
+        _compare(saveload_scene.state(), want)
 
 
 # ---- bad states
