@@ -277,6 +277,15 @@ double planeDistance(const Prepared& block, int f, const Vector3& x) {
 	const Vector3& f0 = block.corner(plane.corners[0]);
 	const Vector3 offset = x - f0;
 	const double d = plane.normal.dot(offset);
+	// The round-off test below, |d| > kRoundoffRelative (|offset| + side1 +
+	// side2), first with a cheap upper bound of |offset| in place of its
+	// sqrt: the 1-norm, times 1 + 1e-6 to cover its rounding and that of the
+	// computed 2-norm (each within a few DBL_EPSILON relative). Every step
+	// (+, x by a positive constant) is monotone in floating point, so a |d|
+	// above the larger threshold is above the exact test's too, and the
+	// function returns d as before; otherwise the exact test decides as before.
+	const double normBound = (std::abs(offset.x()) + std::abs(offset.y()) + std::abs(offset.z())) * (1 + 1e-6);
+	if (std::abs(d) > kRoundoffRelative * (normBound + plane.side1 + plane.side2)) return d;
 	const double scale = offset.norm() + plane.side1 + plane.side2;
 	if (std::abs(d) > kRoundoffRelative * scale) return d;
 	const Vector3& f1 = block.corner(plane.corners[1]);
@@ -527,6 +536,25 @@ std::optional<SubContact> edgeEdgeContact(bool firstIsA, const Prepared& blockI,
 	const Vector3 da = p2 - p1, db = p4 - p3;
 	const double la = da.norm(), lb = db.norm();
 	if (parallelDirections(da, db, la, lb, sinTolerance)) return std::nullopt;
+	const double tol = settings.lengthTolerance;
+	{
+		// The closest points of the two lines must lie strictly inside both
+		// segments (checked last below, on edgeEdgeDistance's s and t). Most
+		// edge pairs fail that, so it is checked first, on the line parameters
+		// edgeEdgeDistance computes by these same expressions: for edges that
+		// are not parallel its s, t are these when both lie in [0, 1], and
+		// otherwise a value clamped to 0 or 1, which the endpoint test rejects
+		// (lengthTolerance > 0). The same pairs are rejected, only sooner.
+		const Vector3 w = p3 - p1;
+		const Vector3 cross = da.cross(db);
+		const double crossNorm = cross.norm();
+		const double nn = crossNorm * crossNorm;
+		const double sLine = w.cross(db).dot(cross) / nn;
+		const double tLine = w.cross(da).dot(cross) / nn;
+		if (!(sLine >= 0 && sLine <= 1 && tLine >= 0 && tLine <= 1)) return std::nullopt;
+		if (sLine * la <= tol || (1 - sLine) * la <= tol || tLine * lb <= tol || (1 - tLine) * lb <= tol)
+			return std::nullopt;
+	}
 	// From block i towards block j: out of i at its edge, into j at its edge.
 	const Vector3 reference = blockI.edgeOutward(e1) - blockJ.edgeOutward(e2);
 	SubContact c;
@@ -541,7 +569,6 @@ std::optional<SubContact> edgeEdgeContact(bool firstIsA, const Prepared& blockI,
 	const EdgeEdgeResult r =
 	    edgeEdgeDistance(p1, p2, p3, p4, reference, settings.lengthTolerance, settings.angleTolerance);
 	if (r.parallel || !r.interior) return std::nullopt;
-	const double tol = settings.lengthTolerance;
 	if (r.s * la <= tol || (1 - r.s) * la <= tol || r.t * lb <= tol || (1 - r.t) * lb <= tol) return std::nullopt;
 	c.kind = ContactKind::EdgeEdge;
 	c.firstIsA = firstIsA;
