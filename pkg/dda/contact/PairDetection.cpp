@@ -73,22 +73,42 @@ constexpr double kCrossRoundoffRelative = 1e-14;
 ExactPoint exactPoint(const Vector3& p) { return ExactPoint(p.x(), p.y(), p.z()); }
 ExactVector exactVector(const Vector3& v) { return ExactVector(v.x(), v.y(), v.z()); }
 
-// A face's plane: the chooseFaceCorners triangle (counter-clockwise seen from
-// outside), its unit normal, and the lengths of the triangle's sides at f0.
-struct FacePlane {
-	std::array<int, 3> corners{};
-	Vector3 normal = Vector3::UnitZ();
-	double side1 = 0, side2 = 0;  // |f1 - f0|, |f2 - f0| [m]
-};
+// Face f's plane (FacePlane without firstNormal/firstNorm). Both the per-call
+// path (ensurePlane) and BlockPlanes::compute use this one function, so a
+// cached plane holds the same doubles as one built per call.
+void buildFacePlane(const std::vector<Vector3>& v, const std::vector<int>& face, FacePlane& plane) {
+	plane.corners = chooseFaceCorners(v, face);
+	const Vector3& f0 = v[plane.corners[0]];
+	const Vector3 cross = (v[plane.corners[1]] - f0).cross(v[plane.corners[2]] - f0);
+	plane.normal = cross.normalized();
+	plane.side1 = (v[plane.corners[1]] - f0).norm();
+	plane.side2 = (v[plane.corners[2]] - f0).norm();
+}
 
-// An edge: its direction (end - start), its length, and the cross product of
-// the outward normals of its two faces (second x first), the great circle of
-// its Gauss-map arc.
-struct EdgeData {
-	Vector3 direction = Vector3::Zero();  // [m]
-	double length = 0;                    // [m]
-	Vector3 arc = Vector3::Zero();        // dimensionless
-};
+// The normal of a face's first three corners (unnormalised), scored by
+// likelySeparatingFace.
+Vector3 firstCornersNormal(const std::vector<Vector3>& v, const std::vector<int>& face) {
+	const Vector3& f0 = v[face[0]];
+	return (v[face[1]] - f0).cross(v[face[2]] - f0);
+}
+
+// Edge e's data from its corners and its faces' planes (shared as above).
+void buildEdge(const std::vector<Vector3>& v, const ConvexPolyhedron& shape, const FacePlane* faces, int e,
+               EdgeData& d) {
+	d.direction = v[shape.edges[e][1]] - v[shape.edges[e][0]];
+	d.length = d.direction.norm();
+	const auto& ef = shape.edgeFaces[e];
+	d.arc = faces[ef[1]].normal.cross(faces[ef[0]].normal);
+}
+
+// Bounding box of the corners.
+void cornerBounds(const std::vector<Vector3>& v, Vector3& lower, Vector3& upper) {
+	lower = upper = v.front();
+	for (const Vector3& x : v) {
+		lower = lower.cwiseMin(x);
+		upper = upper.cwiseMax(x);
+	}
+}
 
 struct FaceCandidate {
 	EntranceFeature feature;
@@ -131,9 +151,13 @@ struct Prepared {
 	const ConvexPolyhedron* shape = nullptr;
 	const std::vector<Vector3>* vertices = nullptr;
 	Vector3 centroid = Vector3::Zero();
-	FacePlane* faces = nullptr;
+	// Face planes: the block's BlockPlanes (every plane built), or the
+	// thread's buffer with planeReady flags (built when first needed).
+	const FacePlane* faces = nullptr;
+	FacePlane* ownFaces = nullptr;  // the buffer, nullptr with BlockPlanes
+	char* planeReady = nullptr;     // nullptr with BlockPlanes
+	const BlockPlanes* planes = nullptr;
 	double* areas = nullptr;
-	char* planeReady = nullptr;
 	double* separations = nullptr;
 	char* separationReady = nullptr;
 	const EdgeData* edges = nullptr;
@@ -188,11 +212,12 @@ Prepared prepareBounds(const BlockGeometry& block) {
 	p.vertices = block.vertices;
 	p.centroid = block.centroid;
 	p.internalFaces = block.internalFaces;
-	const std::vector<Vector3>& v = *block.vertices;
-	p.lower = p.upper = v.front();
-	for (const Vector3& x : v) {
-		p.lower = p.lower.cwiseMin(x);
-		p.upper = p.upper.cwiseMax(x);
+	p.planes = block.planes;
+	if (p.planes) {
+		p.lower = p.planes->lower;
+		p.upper = p.planes->upper;
+	} else {
+		cornerBounds(*block.vertices, p.lower, p.upper);
 	}
 	return p;
 }
@@ -201,44 +226,44 @@ Prepared prepareBounds(const BlockGeometry& block) {
 // (ensurePlane): a pair rejected by one face axis builds few of them.
 void prepareFaces(Prepared& p, Scratch& s, int slot) {
 	const std::size_t count = p.shape->faces.size();
-	s.faces[slot].resize(count);
+	if (p.planes) {
+		p.faces = p.planes->faces.data();
+		p.ownFaces = nullptr;
+		p.planeReady = nullptr;
+	} else {
+		s.faces[slot].resize(count);
+		s.planeReady[slot].assign(count, 0);
+		p.faces = p.ownFaces = s.faces[slot].data();
+		p.planeReady = s.planeReady[slot].data();
+	}
 	s.areas[slot].assign(count, -1.0);
-	s.planeReady[slot].assign(count, 0);
 	s.separations[slot].resize(count);
 	s.separationReady[slot].assign(count, 0);
-	p.faces = s.faces[slot].data();
 	p.areas = s.areas[slot].data();
-	p.planeReady = s.planeReady[slot].data();
 	p.separations = s.separations[slot].data();
 	p.separationReady = s.separationReady[slot].data();
 	p.faceTotal = static_cast<int>(count);
 }
 
 void ensurePlane(const Prepared& p, int f) {
-	if (p.planeReady[f]) return;
-	const std::vector<Vector3>& v = *p.vertices;
-	FacePlane& plane = p.faces[f];
-	plane.corners = chooseFaceCorners(v, p.shape->faces[f]);
-	const Vector3& f0 = v[plane.corners[0]];
-	const Vector3 cross = (v[plane.corners[1]] - f0).cross(v[plane.corners[2]] - f0);
-	plane.normal = cross.normalized();
-	plane.side1 = (v[plane.corners[1]] - f0).norm();
-	plane.side2 = (v[plane.corners[2]] - f0).norm();
+	if (!p.planeReady || p.planeReady[f]) return;
+	buildFacePlane(*p.vertices, p.shape->faces[f], p.ownFaces[f]);
 	p.planeReady[f] = 1;
 }
 
 // Edge data of the edges the pair may use (after prepareSubUnits).
 void prepareEdges(Prepared& p, Scratch& s, int slot) {
+	if (p.planes) {
+		p.edges = p.planes->edges.data();
+		return;
+	}
 	std::vector<EdgeData>& edges = s.edges[slot];
 	edges.resize(p.edgeCount());
 	for (int e : p.edgeList) {
-		EdgeData& d = edges[e];
-		d.direction = p.edgeEnd(e) - p.edgeStart(e);
-		d.length = d.direction.norm();
 		const auto& ef = p.shape->edgeFaces[e];
 		ensurePlane(p, ef[0]);
 		ensurePlane(p, ef[1]);
-		d.arc = p.faces[ef[1]].normal.cross(p.faces[ef[0]].normal);
+		buildEdge(*p.vertices, *p.shape, p.faces, e, edges[e]);
 	}
 	p.edges = edges.data();
 }
@@ -252,6 +277,15 @@ double planeDistance(const Prepared& block, int f, const Vector3& x) {
 	const Vector3& f0 = block.corner(plane.corners[0]);
 	const Vector3 offset = x - f0;
 	const double d = plane.normal.dot(offset);
+	// The round-off test below, |d| > kRoundoffRelative (|offset| + side1 +
+	// side2), first with a cheap upper bound of |offset| in place of its
+	// sqrt: the 1-norm, times 1 + 1e-6 to cover its rounding and that of the
+	// computed 2-norm (each within a few DBL_EPSILON relative). Every step
+	// (+, x by a positive constant) is monotone in floating point, so a |d|
+	// above the larger threshold is above the exact test's too, and the
+	// function returns d as before; otherwise the exact test decides as before.
+	const double normBound = (std::abs(offset.x()) + std::abs(offset.y()) + std::abs(offset.z())) * (1 + 1e-6);
+	if (std::abs(d) > kRoundoffRelative * (normBound + plane.side1 + plane.side2)) return d;
 	const double scale = offset.norm() + plane.side1 + plane.side2;
 	if (std::abs(d) > kRoundoffRelative * scale) return d;
 	const Vector3& f1 = block.corner(plane.corners[1]);
@@ -377,10 +411,14 @@ int likelySeparatingFace(const Prepared& owner, const Vector3& direction) {
 	int best = -1;
 	double bestScore = -std::numeric_limits<double>::infinity();
 	for (int f : owner.faceList) {
-		const std::vector<int>& face = owner.shape->faces[f];
-		const Vector3& f0 = v[face[0]];
-		const Vector3 n = (v[face[1]] - f0).cross(v[face[2]] - f0);
-		const double score = n.dot(direction) / n.norm();
+		double score;
+		if (owner.planes) {
+			const FacePlane& plane = owner.faces[f];
+			score = plane.firstNormal.dot(direction) / plane.firstNorm;
+		} else {
+			const Vector3 n = firstCornersNormal(v, owner.shape->faces[f]);
+			score = n.dot(direction) / n.norm();
+		}
 		if (score > bestScore) {
 			bestScore = score;
 			best = f;
@@ -498,6 +536,25 @@ std::optional<SubContact> edgeEdgeContact(bool firstIsA, const Prepared& blockI,
 	const Vector3 da = p2 - p1, db = p4 - p3;
 	const double la = da.norm(), lb = db.norm();
 	if (parallelDirections(da, db, la, lb, sinTolerance)) return std::nullopt;
+	const double tol = settings.lengthTolerance;
+	{
+		// The closest points of the two lines must lie strictly inside both
+		// segments (checked last below, on edgeEdgeDistance's s and t). Most
+		// edge pairs fail that, so it is checked first, on the line parameters
+		// edgeEdgeDistance computes by these same expressions: for edges that
+		// are not parallel its s, t are these when both lie in [0, 1], and
+		// otherwise a value clamped to 0 or 1, which the endpoint test rejects
+		// (lengthTolerance > 0). The same pairs are rejected, only sooner.
+		const Vector3 w = p3 - p1;
+		const Vector3 cross = da.cross(db);
+		const double crossNorm = cross.norm();
+		const double nn = crossNorm * crossNorm;
+		const double sLine = w.cross(db).dot(cross) / nn;
+		const double tLine = w.cross(da).dot(cross) / nn;
+		if (!(sLine >= 0 && sLine <= 1 && tLine >= 0 && tLine <= 1)) return std::nullopt;
+		if (sLine * la <= tol || (1 - sLine) * la <= tol || tLine * lb <= tol || (1 - tLine) * lb <= tol)
+			return std::nullopt;
+	}
 	// From block i towards block j: out of i at its edge, into j at its edge.
 	const Vector3 reference = blockI.edgeOutward(e1) - blockJ.edgeOutward(e2);
 	SubContact c;
@@ -512,7 +569,6 @@ std::optional<SubContact> edgeEdgeContact(bool firstIsA, const Prepared& blockI,
 	const EdgeEdgeResult r =
 	    edgeEdgeDistance(p1, p2, p3, p4, reference, settings.lengthTolerance, settings.angleTolerance);
 	if (r.parallel || !r.interior) return std::nullopt;
-	const double tol = settings.lengthTolerance;
 	if (r.s * la <= tol || (1 - r.s) * la <= tol || r.t * lb <= tol || (1 - r.t) * lb <= tol) return std::nullopt;
 	c.kind = ContactKind::EdgeEdge;
 	c.firstIsA = firstIsA;
@@ -785,6 +841,21 @@ bool previousLinked(const Prepared& a, const Prepared& b, const EntranceFeature&
 }
 
 }  // namespace
+
+void BlockPlanes::compute(const ConvexPolyhedron& shape, const std::vector<Vector3>& vertices) {
+	const int faceCount = static_cast<int>(shape.faces.size());
+	faces.resize(faceCount);
+	for (int f = 0; f < faceCount; ++f) {
+		FacePlane& plane = faces[f];
+		buildFacePlane(vertices, shape.faces[f], plane);
+		plane.firstNormal = firstCornersNormal(vertices, shape.faces[f]);
+		plane.firstNorm = plane.firstNormal.norm();
+	}
+	const int edgeCount = static_cast<int>(shape.edges.size());
+	edges.resize(edgeCount);
+	for (int e = 0; e < edgeCount; ++e) buildEdge(vertices, shape, faces.data(), e, edges[e]);
+	cornerBounds(vertices, lower, upper);
+}
 
 const char* contactTypeName(ContactType type) {
 	switch (type) {

@@ -88,6 +88,7 @@
 #include "SubUnits.hpp"
 #include "dda/geometry/ConvexPolyhedron.hpp"
 
+#include <array>
 #include <optional>
 #include <vector>
 
@@ -105,6 +106,40 @@ enum class ContactType {
 };
 const char* contactTypeName(ContactType type);  // "VV", "VE", "VF", "EE", "EEp", "EF", "FF"
 
+// A face's plane as the narrow phase uses it: the chooseFaceCorners triangle
+// (counter-clockwise seen from outside), its unit normal, the lengths of the
+// triangle's sides at f0, and the (unnormalised) normal of the face's first
+// three corners with its length (likeliest separating face, step 1).
+struct FacePlane {
+	std::array<int, 3> corners{};
+	Vector3 normal = Vector3::UnitZ();
+	double side1 = 0, side2 = 0;                // |f1 - f0|, |f2 - f0| [m]
+	Vector3 firstNormal = Vector3::UnitZ();     // (v1 - v0) x (v2 - v0) [m^2]
+	double firstNorm = 1;                       // |firstNormal| [m^2]
+};
+
+// An edge: its direction (end - start), its length, and the cross product of
+// the outward normals of its two faces (second x first), the great circle of
+// its Gauss-map arc.
+struct EdgeData {
+	Vector3 direction = Vector3::Zero();  // [m]
+	double length = 0;                    // [m]
+	Vector3 arc = Vector3::Zero();        // dimensionless
+};
+
+// A block's face planes, edge data and bounding box, computed once for its
+// current corners and shared by every pair the block is in (World fills one
+// per block of a candidate pair before its parallel pair loop; the pair loop
+// only reads them). The values are those the narrow phase computes per pair
+// without it (same expressions), so results do not depend on whether it is
+// given. Valid until the block's corners change.
+struct BlockPlanes {
+	std::vector<FacePlane> faces;
+	std::vector<EdgeData> edges;
+	Vector3 lower = Vector3::Zero(), upper = Vector3::Zero();  // bounding box of the corners [m]
+	void compute(const ConvexPolyhedron& shape, const std::vector<Vector3>& vertices);
+};
+
 // A block as the narrow phase sees it: current corners [m] and topology.
 struct BlockGeometry {
 	const ConvexPolyhedron* shape = nullptr;       // faces, edges, edgeFaces
@@ -117,6 +152,9 @@ struct BlockGeometry {
 	// this, a block sliding across the joint meets the covered side face as a
 	// "ghost" obstacle.
 	const std::vector<char>* internalFaces = nullptr;
+	// Optional: the block's planes for its current corners (BlockPlanes); when
+	// absent the narrow phase builds what it needs per call.
+	const BlockPlanes* planes = nullptr;
 };
 
 // Which feature is the pair's entrance feature (step 2).

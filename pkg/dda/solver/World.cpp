@@ -331,6 +331,24 @@ void World::detectContacts(const IntegratorSettings& settings, StepStatistics& s
 	std::vector<double>& diagonal = diagonals_;
 	diagonal.resize(blocks_.size());
 	for (std::size_t b = 0; b < blocks_.size(); ++b) diagonal[b] = boundingDiagonal(blocks_[b]);
+	// Each block's planes once for all its pairs (a block is in a few
+	// candidate pairs), written here and only read by the pair loop.
+	planes_.resize(blocks_.size());
+	inPair_.assign(blocks_.size(), 0);
+	planeBlocks_.clear();
+	for (const auto& [a, b] : pairs_) {
+		for (const int k : {a, b}) {
+			if (inPair_[k]) continue;
+			inPair_[k] = 1;
+			planeBlocks_.push_back(k);
+		}
+	}
+	const int planeCount = static_cast<int>(planeBlocks_.size());
+#pragma omp parallel for schedule(dynamic, 32) if (pairCount >= kMinBlocksForThreads)
+	for (int k = 0; k < planeCount; ++k) {
+		const Block& block = blocks_[planeBlocks_[k]];
+		planes_[planeBlocks_[k]].compute(*block.shape, block.vertices);
+	}
 #pragma omp parallel for schedule(dynamic, 16) if (pairCount >= kMinBlocksForThreads)
 	for (int p = 0; p < pairCount; ++p) {
 		const auto [a, b] = pairs_[p];
@@ -340,8 +358,9 @@ void World::detectContacts(const IntegratorSettings& settings, StepStatistics& s
 		    pairDetectionSettings(diagonal[a], diagonal[b], stats.contactDistance, stats.allowedDisplacement);
 		const std::vector<char>* internalA = internalFaces_[a].empty() ? nullptr : &internalFaces_[a];
 		const std::vector<char>* internalB = internalFaces_[b].empty() ? nullptr : &internalFaces_[b];
-		pairResults_[p] = detectPairContacts(BlockGeometry{A.shape.get(), &A.vertices, A.centroid, internalA},
-		                                     BlockGeometry{B.shape.get(), &B.vertices, B.centroid, internalB}, detection,
+		pairResults_[p] = detectPairContacts(BlockGeometry{A.shape.get(), &A.vertices, A.centroid, internalA, &planes_[a]},
+		                                     BlockGeometry{B.shape.get(), &B.vertices, B.centroid, internalB, &planes_[b]},
+		                                     detection,
 		                                     store_.previousEntrance(a, b), collider_->linked(p), &pairWork_[p]);
 	}
 	for (int p = 0; p < pairCount; ++p) {

@@ -95,6 +95,12 @@ private:
 	std::vector<const Block*> movingBlocks_;
 	std::vector<BlockMotion> motions_;
 	std::vector<double> diagonals_;  // per block, bounding-box diagonal of this step [m]
+	// Per block, its face planes, edge data and bounding box for this step's
+	// detection (BlockPlanes), built before the parallel pair loop for the
+	// blocks of a candidate pair (planeBlocks_); read-only during the loop.
+	std::vector<BlockPlanes> planes_;
+	std::vector<char> inPair_;
+	std::vector<int> planeBlocks_;
 	// Faces of fixed blocks covered by a flush neighbour (BlockGeometry::internalFaces).
 	std::vector<std::vector<char>> internalFaces_;
 	int internalFacesBlocks_ = -1;  // block count when internalFaces_ was computed
