@@ -128,6 +128,8 @@ struct Scratch {
 	std::vector<double> cornerDistances;
 	std::vector<char> cornerDistanceReady;
 	std::vector<int> used, faceEdges;
+	std::vector<int> edgeFacesB, arcSides;  // the edge axes' Gauss-map test
+	std::vector<char> faceMark;
 	std::vector<Vector3> pointsA, pointsB;
 	std::vector<int> identity;  // 0, 1, 2, ...: "every sub-unit"
 	std::vector<char> vertexLinked[2];
@@ -272,7 +274,9 @@ void prepareEdges(Prepared& p, Scratch& s, int slot) {
 // Below round-off the sign is decided exactly: a point exactly on the
 // triangle's plane gets exactly 0, a point whose double distance has the
 // wrong sign gets 0.
-double planeDistance(const Prepared& block, int f, const Vector3& x) {
+double planeDistanceNearPlane(const Prepared& block, int f, const Vector3& x, const Vector3& offset, double d);
+
+inline double planeDistance(const Prepared& block, int f, const Vector3& x) {
 	const FacePlane& plane = block.faces[f];
 	const Vector3& f0 = block.corner(plane.corners[0]);
 	const Vector3 offset = x - f0;
@@ -286,6 +290,14 @@ double planeDistance(const Prepared& block, int f, const Vector3& x) {
 	// function returns d as before; otherwise the exact test decides as before.
 	const double normBound = (std::abs(offset.x()) + std::abs(offset.y()) + std::abs(offset.z())) * (1 + 1e-6);
 	if (std::abs(d) > kRoundoffRelative * (normBound + plane.side1 + plane.side2)) return d;
+	return planeDistanceNearPlane(block, f, x, offset, d);
+}
+
+// planeDistance's exact test, for a point near the plane (out of line).
+[[gnu::noinline]] double planeDistanceNearPlane(const Prepared& block, int f, const Vector3& x, const Vector3& offset,
+                                                double d) {
+	const FacePlane& plane = block.faces[f];
+	const Vector3& f0 = block.corner(plane.corners[0]);
 	const double scale = offset.norm() + plane.side1 + plane.side2;
 	if (std::abs(d) > kRoundoffRelative * scale) return d;
 	const Vector3& f1 = block.corner(plane.corners[1]);
@@ -341,9 +353,11 @@ bool projectionNearFace(const Prepared& block, int f, const Vector3& x, double r
 // Two edge directions are parallel: exactly (cross product of the double
 // vectors zero, decided by CGAL) or within the angle tolerance.
 // sinTolerance = sin(angleTolerance); la = |da|, lb = |db|.
-bool parallelDirections(const Vector3& da, const Vector3& db, double la, double lb, double sinTolerance) {
-	const Vector3 cross = da.cross(db);
-	if (cross.norm() <= sinTolerance * la * lb) return true;
+// `cross` = da x db and `crossNorm` = |cross| as computed by the callers
+// (Eigen's cross() and norm()).
+bool parallelDirections(const Vector3& da, const Vector3& db, const Vector3& cross, double crossNorm, double la,
+                        double lb, double sinTolerance) {
+	if (crossNorm <= sinTolerance * la * lb) return true;
 	// Not within the angle: parallel only when exactly collinear. A component
 	// of the double cross product above its round-off bound proves it is not.
 	const double scale = da.cwiseAbs().maxCoeff() * db.cwiseAbs().maxCoeff();
@@ -352,7 +366,8 @@ bool parallelDirections(const Vector3& da, const Vector3& db, double la, double 
 }
 
 bool parallelDirections(const Vector3& da, const Vector3& db, double sinTolerance) {
-	return parallelDirections(da, db, da.norm(), db.norm(), sinTolerance);
+	const Vector3 cross = da.cross(db);
+	return parallelDirections(da, db, cross, cross.norm(), da.norm(), db.norm(), sinTolerance);
 }
 
 // Exact sign of the triple product x . (y x z) of three unit vectors, given
@@ -374,17 +389,28 @@ int unitOrientation(double approx, const Vector3& x, const Vector3& y, const Vec
 // edge eb of B (c, d: minus its faces' normals) cross (strictly)? Signs of
 // triple products decided exactly (Gregorius, "The separating axis test
 // between convex polyhedra", GDC 2013).
-bool arcsCross(const Prepared& a, int ea, const Prepared& b, int eb) {
+//
+// The first two signs depend on ea and on one face of B only: the caller
+// computes them once per (ea, face of B) with arcSide and passes
+// cba = arcSide(a, ea, b, fb[0]), dba = arcSide(a, ea, b, fb[1]) (the same
+// expressions the test evaluated per edge pair), having checked
+// cba * dba < 0.
+int arcSide(const Prepared& a, int ea, const Prepared& b, int g) {
+	const auto& fa = a.shape->edgeFaces[ea];
+	const Vector3& A = a.faces[fa[0]].normal;
+	const Vector3& B = a.faces[fa[1]].normal;
+	const Vector3 C = -b.faces[g].normal;
+	const Vector3& ba = a.edges[ea].arc;                // B x A
+	return unitOrientation(C.dot(ba), C, B, A);  // C . (B x A)
+}
+
+bool arcsCross(const Prepared& a, int ea, const Prepared& b, int eb, int cba) {
 	const auto& fa = a.shape->edgeFaces[ea];
 	const auto& fb = b.shape->edgeFaces[eb];
 	const Vector3& A = a.faces[fa[0]].normal;
 	const Vector3& B = a.faces[fa[1]].normal;
 	const Vector3 C = -b.faces[fb[0]].normal, D = -b.faces[fb[1]].normal;
-	const Vector3& ba = a.edges[ea].arc;  // B x A
 	const Vector3& dc = b.edges[eb].arc;  // (-D) x (-C) = D x C
-	const int cba = unitOrientation(C.dot(ba), C, B, A);  // C . (B x A)
-	const int dba = unitOrientation(D.dot(ba), D, B, A);
-	if (!(cba * dba < 0)) return false;
 	const int adc = unitOrientation(A.dot(dc), A, D, C);  // A . (D x C)
 	const int bdc = unitOrientation(B.dot(dc), B, D, C);
 	return adc * bdc < 0 && cba * bdc > 0;
@@ -435,24 +461,33 @@ struct EdgeAxis {
 
 // Edge axis of edge ea of A and eb of B when the two edges form a face of the
 // Minkowski difference and are not parallel.
-EdgeAxis edgeAxis(const Prepared& a, int ea, const Prepared& b, int eb, double sinTolerance) {
+// `cba`: arcSide(a, ea, b, first face of eb), after the caller's check that
+// the two faces of eb are on opposite sides (arcsCross).
+EdgeAxis edgeAxis(const Prepared& a, int ea, const Prepared& b, int eb, double sinTolerance, int cba) {
 	EdgeAxis axis;
-	if (!arcsCross(a, ea, b, eb)) return axis;
+	if (!arcsCross(a, ea, b, eb, cba)) return axis;
 	const EdgeData& ed = a.edges[ea];
 	const EdgeData& fd = b.edges[eb];
 	const Vector3& da = ed.direction;
 	const Vector3& db = fd.direction;
-	if (parallelDirections(da, db, ed.length, fd.length, sinTolerance)) return axis;
+	const Vector3 cross = da.cross(db);
+	const double crossNorm = cross.norm();
+	if (parallelDirections(da, db, cross, crossNorm, ed.length, fd.length, sinTolerance)) return axis;
 	const Vector3& a0 = a.edgeStart(ea);
 	const Vector3& a1 = a.edgeEnd(ea);
 	const Vector3& b0 = b.edgeStart(eb);
 	const Vector3& b1 = b.edgeEnd(eb);
-	Vector3 n = da.cross(db).normalized();
+	// da.cross(db).normalized(): Eigen divides by sqrt(squaredNorm()) = norm()
+	// when that is > 0, which it is for directions that are not parallel.
+	Vector3 n = cross / crossNorm;
 	if (n.dot(a0 - a.centroid) < 0) n = -n;
 	const Vector3 offset = b0 - a0;
 	double separation = n.dot(offset);
-	const double scale = offset.norm() + ed.length + fd.length;
-	if (std::abs(separation) <= kRoundoffRelative * scale &&
+	// The round-off test with an upper bound of |offset| first (as in
+	// planeDistance): a separation above it is above the exact test's too.
+	const double normBound = (std::abs(offset.x()) + std::abs(offset.y()) + std::abs(offset.z())) * (1 + 1e-6);
+	const bool clear = std::abs(separation) > kRoundoffRelative * (normBound + ed.length + fd.length);
+	if (!clear && std::abs(separation) <= kRoundoffRelative * (offset.norm() + ed.length + fd.length) &&
 	    CGAL::orientation(exactPoint(a0), exactPoint(a1), exactPoint(b0), exactPoint(b1)) == CGAL::COPLANAR)
 		separation = 0;
 	axis.valid = true;
@@ -535,7 +570,9 @@ std::optional<SubContact> edgeEdgeContact(bool firstIsA, const Prepared& blockI,
 	const Vector3& p4 = blockJ.edgeEnd(e2);
 	const Vector3 da = p2 - p1, db = p4 - p3;
 	const double la = da.norm(), lb = db.norm();
-	if (parallelDirections(da, db, la, lb, sinTolerance)) return std::nullopt;
+	const Vector3 cross = da.cross(db);
+	const double crossNorm = cross.norm();
+	if (parallelDirections(da, db, cross, crossNorm, la, lb, sinTolerance)) return std::nullopt;
 	const double tol = settings.lengthTolerance;
 	{
 		// The closest points of the two lines must lie strictly inside both
@@ -546,8 +583,6 @@ std::optional<SubContact> edgeEdgeContact(bool firstIsA, const Prepared& blockI,
 		// otherwise a value clamped to 0 or 1, which the endpoint test rejects
 		// (lengthTolerance > 0). The same pairs are rejected, only sooner.
 		const Vector3 w = p3 - p1;
-		const Vector3 cross = da.cross(db);
-		const double crossNorm = cross.norm();
 		const double nn = crossNorm * crossNorm;
 		const double sLine = w.cross(db).dot(cross) / nn;
 		const double tLine = w.cross(da).dot(cross) / nn;
@@ -564,7 +599,7 @@ std::optional<SubContact> edgeEdgeContact(bool firstIsA, const Prepared& blockI,
 	if (!valid) return std::nullopt;
 	if (c.gap > limits.highestGap || c.gap < limits.deepestGap) return std::nullopt;
 	// The stencil's n = -sigma (a x b)/|a x b| points from i to j.
-	c.normal = c.stencil.sigma * da.cross(db).normalized();
+	c.normal = c.stencil.sigma * (cross / crossNorm);  // da.cross(db).normalized(), as in edgeAxis
 	if (limits.direction && c.normal.dot(*limits.direction) < limits.minCosine) return std::nullopt;
 	const EdgeEdgeResult r =
 	    edgeEdgeDistance(p1, p2, p3, p4, reference, settings.lengthTolerance, settings.angleTolerance);
@@ -928,12 +963,33 @@ std::optional<PairContacts> detectPairContacts(const BlockGeometry& blockA, cons
 	prepareEdges(b, s, 1);
 	EdgeAxis bestEdge, previousEdge;
 	int bestEdgeA = -1, bestEdgeB = -1;
+	// The faces of B at its edges (their planes are built: prepareEdges).
+	std::vector<int>& bFaces = s.edgeFacesB;
+	std::vector<int>& side = s.arcSides;
+	{
+		std::vector<char>& mark = s.faceMark;
+		mark.assign(b.faceCount(), 0);
+		bFaces.clear();
+		for (int eb : b.edgeList) {
+			if (b.internalEdge(eb)) continue;
+			for (int g : b.shape->edgeFaces[eb]) {
+				if (mark[g]) continue;
+				mark[g] = 1;
+				bFaces.push_back(g);
+			}
+		}
+		side.resize(b.faceCount());
+	}
 	for (int ea : a.edgeList) {
 		if (a.internalEdge(ea)) continue;
+		for (int g : bFaces) side[g] = arcSide(a, ea, b, g);
 		for (int eb : b.edgeList) {
 			if (b.internalEdge(eb)) continue;
 			++tests;
-			const EdgeAxis axis = edgeAxis(a, ea, b, eb, sinTolerance);
+			// Gauss-map arcs that cannot cross (arcsCross's first test).
+			const auto& fb = b.shape->edgeFaces[eb];
+			if (!(side[fb[0]] * side[fb[1]] < 0)) continue;
+			const EdgeAxis axis = edgeAxis(a, ea, b, eb, sinTolerance, side[fb[0]]);
 			if (!axis.valid) continue;
 			if (axis.separation > d0) return std::nullopt;
 			deepestBound = std::max(deepestBound, axis.separation);
