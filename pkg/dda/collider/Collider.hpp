@@ -117,7 +117,7 @@ public:
 	               BroadPhaseStatistics& stats) override;
 	void setPairReuse(bool reuse) override;
 	std::size_t memoryBytes() const override {
-		return capacityBytes(boxes_) + capacityBytes(order_) + capacityBytes(searchedBoxes_) + capacityBytes(cached_) +
+		return capacityBytes(boxes_) + capacityBytes(order_) + capacityBytes(fixed_) + capacityBytes(searchedBoxes_) + capacityBytes(cached_) +
 		       capacityBytes(kept_) + capacityBytes(searchedFixed_) + capacityBytes(moved_) + capacityBytes(movers_);
 	}
 
@@ -128,6 +128,7 @@ private:
 	           std::vector<std::pair<int, int>>& pairs);
 	std::vector<Eigen::AlignedBox3d> boxes_;  // this call's boxes, widened by d0
 	std::vector<int> order_;
+	std::vector<char> fixed_;  // per block, for the sweep
 	bool reuse_ = true;
 	// The cache: each block's D-box from when it was last searched, every
 	// pair (not both fixed) whose D-boxes meet, sorted, and the fixed flags.

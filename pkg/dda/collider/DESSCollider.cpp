@@ -30,6 +30,8 @@ long DESSCollider::sweep(const std::vector<Block>& blocks, const std::vector<Eig
 	all.sizes().maxCoeff(&axis);
 	order_.resize(n);
 	for (int b = 0; b < n; ++b) order_[b] = b;
+	fixed_.resize(n);  // the flags in one compact array (blocks are large and far apart)
+	for (int b = 0; b < n; ++b) fixed_[b] = blocks[b].fixed;
 	std::sort(order_.begin(), order_.end(), [&](int a, int b) {
 		const double ma = boxes[a].min()(axis), mb = boxes[b].min()(axis);
 		return ma < mb || (ma == mb && a < b);
@@ -41,7 +43,7 @@ long DESSCollider::sweep(const std::vector<Block>& blocks, const std::vector<Eig
 		for (int q = p + 1; q < n; ++q) {
 			const int b = order_[q];
 			if (boxes[b].min()(axis) > boxA.max()(axis)) break;
-			if (blocks[a].fixed && blocks[b].fixed) continue;
+			if (fixed_[a] && fixed_[b]) continue;
 			++tested;
 			if (boxA.intersects(boxes[b])) pairs.emplace_back(std::min(a, b), std::max(a, b));
 		}

@@ -327,22 +327,42 @@ long MSCCollider::gridSearch(const std::vector<Block>& blocks, const std::vector
 		             : static_cast<std::uint64_t>(c.x()) << 42 | static_cast<std::uint64_t>(c.y()) << 21 |
 		                   static_cast<std::uint64_t>(c.z());
 	};
+	// Per shell its block's fixed flag, read from one compact array (the
+	// blocks themselves are large and far apart in memory).
+	shellFixed_.resize(shellTotal);
+	for (int s = 0; s < shellTotal; ++s) shellFixed_[s] = blocks[shellBlock_[s]].fixed;
 	long tests = 0;
 	const auto compare = [&](int s, int t) {
 		const int a = shellBlock_[s], b = shellBlock_[t];
-		if (a == b || (blocks[a].fixed && blocks[b].fixed)) return;
+		if (a == b || (shellFixed_[s] && shellFixed_[t])) return;
 		++tests;
 		if (!boxes[s].intersects(boxes[t])) return;
 		out.push_back(a < b ? ShellPair{a, b, s, t} : ShellPair{b, a, t, s});
 	};
-	// The shells of cell `here`: cellShells_[first, last), ascending.
+	// The shells of cell `here`: cellShells_[first, last), ascending. The
+	// three conditions (this pair's cell, two blocks not both fixed, boxes
+	// that meet) are evaluated together, without a branch each (they are
+	// unpredictable and the tests cheap).
 	const auto scanCell = [&](std::uint64_t here, std::size_t first, std::size_t last) {
 		for (std::size_t p = first; p < last; ++p) {
 			const int s = cellShells_[p];
+			const int a = shellBlock_[s];
+			const bool fixedA = shellFixed_[s];
+			const Vector3& lowS = boxes[s].min();
+			const Vector3& highS = boxes[s].max();
 			for (std::size_t q = p + 1; q < last; ++q) {
 				const int t = cellShells_[q];
-				if (key(cellLow_[s].max(cellLow_[t])) != here) continue;  // compared in another cell
-				compare(s, t);
+				const bool mine = key(cellLow_[s].max(cellLow_[t])) == here;  // else compared in another cell
+				const bool pair = (shellBlock_[t] != a) & !(fixedA & static_cast<bool>(shellFixed_[t]));
+				const Vector3& lowT = boxes[t].min();
+				const Vector3& highT = boxes[t].max();
+				const bool meet = (lowS.x() <= highT.x()) & (lowT.x() <= highS.x()) & (lowS.y() <= highT.y()) &
+				                  (lowT.y() <= highS.y()) & (lowS.z() <= highT.z()) & (lowT.z() <= highS.z());
+				tests += mine & pair;
+				if (mine & pair & meet) {
+					const int b = shellBlock_[t];
+					out.push_back(a < b ? ShellPair{a, b, s, t} : ShellPair{b, a, t, s});
+				}
 			}
 		}
 	};
@@ -579,7 +599,7 @@ std::size_t MSCCollider::memoryBytes() const {
 	                    capacityBytes(pointStart_) + capacityBytes(shellBlock_) + capacityBytes(shellIndex_) +
 	                    capacityBytes(widened_) + capacityBytes(cellLow_) + capacityBytes(cellHigh_) +
 	                    capacityBytes(cellEntries_) + capacityBytes(cellShells_) + capacityBytes(cellStart_) +
-	                    capacityBytes(oversize_) + capacityBytes(isOversize_) + capacityBytes(hits_) +
+	                    capacityBytes(oversize_) + capacityBytes(isOversize_) + capacityBytes(shellFixed_) + capacityBytes(hits_) +
 	                    capacityBytes(candidates_) + capacityBytes(linked_) + capacityBytes(searchBoxes_) +
 	                    capacityBytes(cached_) + capacityBytes(kept_) + capacityBytes(searchedFixed_) +
 	                    capacityBytes(moved_) + capacityBytes(movers_) + overrides_.size() * (sizeof(Override) + 48);

@@ -232,7 +232,7 @@ private:
 	std::vector<std::uint32_t> cellStart_;    // dense keys: where each cell's shells start
 	bool denseGrid_ = false;
 	std::vector<int> oversize_;   // shells compared with every shell
-	std::vector<char> isOversize_;
+	std::vector<char> isOversize_, shellFixed_;
 	std::vector<ShellPair> hits_;
 	std::vector<Candidate> candidates_;
 	std::vector<LinkedSubUnits> linked_;  // the first linkedCount_ are valid
