@@ -16,6 +16,12 @@ countReal() (overlapping volumes) and the collider and InteractionLoop execTime.
 The first step is reported apart (it builds shells, sorts from scratch and, in YADE,
 creates every interaction) and left out of the means.
 
+The DDA strategies search every step (reuseCandidatePairs=False); the strategies
+'MSC:reuseCandidatePairs=1' and 'DESS:reuseCandidatePairs=1' run with the integrator's
+default pair cache, as a user would. Scenes of up to 1,000 blocks run every strategy in
+alternating rounds (--rounds, default 3) and report the median round; the machine's
+load changes between rounds fall on all strategies alike.
+
 Writes bench/out/colliders.json (everything, the issue's targets evaluated, machine,
 versions, exactly what each program was told), PNG plots beside it, and prints a table.
 Run: make bench, or /usr/bin/python3 bench/colliders.py [--quick] [--sizes 1000,10000]
