@@ -409,6 +409,23 @@ long MSCCollider::gridSearch(const std::vector<Block>& blocks, const std::vector
 	return tests;
 }
 
+void MSCCollider::sortShellPairs(std::vector<ShellPair>& pairs, int blocks) {
+	// By counting on the first block (stable), then each block's few pairs
+	// by (b, s, t): the order of ShellPair::operator<.
+	pairStart_.assign(static_cast<std::size_t>(blocks) + 1, 0);
+	for (const ShellPair& p : pairs) ++pairStart_[p.a + 1];
+	for (int b = 0; b < blocks; ++b) pairStart_[b + 1] += pairStart_[b];
+	sortedPairs_.resize(pairs.size());
+	for (const ShellPair& p : pairs) sortedPairs_[pairStart_[p.a]++] = p;
+	pairs.swap(sortedPairs_);
+	std::size_t first = 0;
+	for (int b = 0; b < blocks; ++b) {
+		const std::size_t last = pairStart_[b];  // now the end of block b's pairs
+		if (last - first > 1) std::sort(pairs.begin() + first, pairs.begin() + last);
+		first = last;
+	}
+}
+
 bool MSCCollider::apartInFrame(int s, int t, const Eigen::Matrix3d& m, const Eigen::Matrix3d& size,
                                const Vector3& offset, double limit) const {
 	const Vector3 middle = offset + m * (0.5 * (extentLow_[t] + extentHigh_[t]));
@@ -476,7 +493,7 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 		cacheValid_ = false;
 		stats.shellTests = gridSearch(blocks, widened_, hits_);
 		stats.blocksResearched = n;
-		std::sort(hits_.begin(), hits_.end());
+		sortShellPairs(hits_, n);
 	} else {
 		// Blocks with a d0-box outside its D-box (the same floats as the
 		// final test: boxes inside D-boxes that meet imply D-boxes that meet).
@@ -503,7 +520,7 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 			searchedFixed_.resize(n);
 			for (int b = 0; b < n; ++b) searchedFixed_[b] = blocks[b].fixed;
 			stats.shellTests = gridSearch(blocks, searchBoxes_, cached_);
-			std::sort(cached_.begin(), cached_.end());
+			sortShellPairs(cached_, n);
 			stats.blocksResearched = n;
 			cacheValid_ = true;
 		} else {
@@ -531,7 +548,7 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 								kept_.push_back(m < b ? ShellPair{m, b, s, t} : ShellPair{b, m, t, s});
 						}
 				}
-				std::sort(kept_.begin(), kept_.end());
+				sortShellPairs(kept_, n);
 				cached_.swap(kept_);
 			} else {
 				stats.pairsReused = static_cast<long>(cached_.size());
@@ -599,7 +616,8 @@ std::size_t MSCCollider::memoryBytes() const {
 	                    capacityBytes(pointStart_) + capacityBytes(shellBlock_) + capacityBytes(shellIndex_) +
 	                    capacityBytes(widened_) + capacityBytes(cellLow_) + capacityBytes(cellHigh_) +
 	                    capacityBytes(cellEntries_) + capacityBytes(cellShells_) + capacityBytes(cellStart_) +
-	                    capacityBytes(oversize_) + capacityBytes(isOversize_) + capacityBytes(shellFixed_) + capacityBytes(hits_) +
+	                    capacityBytes(oversize_) + capacityBytes(isOversize_) + capacityBytes(shellFixed_) +
+	                    capacityBytes(pairStart_) + capacityBytes(sortedPairs_) + capacityBytes(hits_) +
 	                    capacityBytes(candidates_) + capacityBytes(linked_) + capacityBytes(searchBoxes_) +
 	                    capacityBytes(cached_) + capacityBytes(kept_) + capacityBytes(searchedFixed_) +
 	                    capacityBytes(moved_) + capacityBytes(movers_) + overrides_.size() * (sizeof(Override) + 48);

@@ -203,6 +203,8 @@ private:
 	// elementwise, offset = a.axes x (b.origin - a.origin)).
 	bool apartInFrame(int s, int t, const Eigen::Matrix3d& m, const Eigen::Matrix3d& size, const Vector3& offset,
 	                  double limit) const;
+	// Sorts shell pairs in ShellPair order (counting sort on the first block).
+	void sortShellPairs(std::vector<ShellPair>& pairs, int blocks);
 	// Index into cover.linkedSets of the set for `shells` (built when new).
 	static int linkedSet(BlockCover& cover, std::uint64_t shells);
 
@@ -233,6 +235,8 @@ private:
 	bool denseGrid_ = false;
 	std::vector<int> oversize_;   // shells compared with every shell
 	std::vector<char> isOversize_, shellFixed_;
+	std::vector<std::size_t> pairStart_;  // sortShellPairs' counts
+	std::vector<ShellPair> sortedPairs_;
 	std::vector<ShellPair> hits_;
 	std::vector<Candidate> candidates_;
 	std::vector<LinkedSubUnits> linked_;  // the first linkedCount_ are valid
