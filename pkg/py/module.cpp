@@ -296,6 +296,10 @@ py::dict lastStep(const SceneLink& s) {
 	times["update"] = st.timeUpdate;
 	times["core"] = st.timeTotal;
 	d["time"] = times;
+	py::dict cpu;
+	cpu["broadPhase"] = st.cpuBroadPhase;
+	cpu["narrowPhase"] = st.cpuNarrowPhase;
+	d["cpuTime"] = cpu;
 	return d;
 }
 

@@ -186,7 +186,10 @@ def stats():
     phase's arrays: boxes, shells, grid, caches) and ``contacts`` (the contact
     store with the previous step's contacts, and the per-pair results).
     ``time``: wall seconds per phase: broadPhase, narrowPhase, assembly,
-    solve, update, core, sync. ``syncedBodies`` and ``syncs``
+    solve, update, core, sync. ``cpuTime``: the process's CPU seconds (all
+    threads) in broadPhase and narrowPhase; with one thread it is the work
+    without the machine's waits, steadier than wall time on a busy machine.
+    ``syncedBodies`` and ``syncs``
     (bodies written by the last sync, syncs so far), ``syncTimeTotal`` and
     ``stepTimeTotal`` [s] (all syncs; all integrator calls, sync included).
 

@@ -591,6 +591,12 @@ TEST(MSCCollider, MemoryStatisticsCountTheArraysHeld) {
 	const StepStatistics nbs = run(std::make_unique<NBSCollider>());
 	ASSERT_GT(dess.contacts, 10);
 	for (const StepStatistics* s : {&dess, &msc, &nbs}) {
+		// The phases' process CPU time: some was spent, and not more than the
+		// step's wall time times the threads that may run (2 here) plus a
+		// clock tick, with margin.
+		EXPECT_GT(s->cpuNarrowPhase, 0);
+		EXPECT_GE(s->cpuBroadPhase, 0);
+		EXPECT_LE(s->cpuBroadPhase + s->cpuNarrowPhase, s->timeTotal * 4 + 0.02);
 		EXPECT_GE(s->contactBytes, static_cast<long>(s->contacts * sizeof(Contact)));
 		EXPECT_LT(s->contactBytes, static_cast<long>(s->contacts * sizeof(Contact)) * 20 + (1 << 20));
 	}

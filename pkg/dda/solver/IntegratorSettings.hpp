@@ -127,6 +127,10 @@ struct StepStatistics {
 	int bondedContacts = 0;          // contacts bonded at the end of the step
 	int fixedBlocks = 0;             // blocks without unknowns
 	bool staticAnalysis = false;     // velocityRatio == 0: velocities reset every step (Shi's static analysis)
+	// CPU time of the contact detection's phases, the process's (all
+	// threads) [s]: with one thread, the work without the machine's waits
+	double cpuBroadPhase = 0;
+	double cpuNarrowPhase = 0;
 	// wall time per phase [s]
 	double timeBroadPhase = 0;
 	double timeNarrowPhase = 0;

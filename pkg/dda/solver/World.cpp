@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <sstream>
 
 namespace dda {
@@ -45,6 +46,13 @@ constexpr double kNormalForceTolerance = 1e-4;
 constexpr int kNormalForceSolves = 6;
 double secondsSince(Clock::time_point start) {
 	return std::chrono::duration<double>(Clock::now() - start).count();
+}
+// CPU time of the whole process, all threads [s] (not wall time: a busy or
+// virtualised machine's waits are not counted).
+double processCpuSeconds() {
+	timespec now{};
+	clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &now);
+	return static_cast<double>(now.tv_sec) + 1e-9 * static_cast<double>(now.tv_nsec);
 }
 void requireFinite(const Vector3& v, const char* what) {
 	if (!v.allFinite()) {
@@ -304,6 +312,7 @@ const Vector12& World::ofBlock(const std::vector<Vector12>& perMovingBlock, int 
 
 void World::detectContacts(const IntegratorSettings& settings, StepStatistics& stats) {
 	auto phase = Clock::now();
+	double cpu = processCpuSeconds();
 	BroadPhaseStatistics broad;
 	collider_->setPairReuse(settings.reuseCandidatePairs);
 	collider_->findPairs(blocks_, stats.contactDistance, pairs_, broad);
@@ -318,8 +327,10 @@ void World::detectContacts(const IntegratorSettings& settings, StepStatistics& s
 	stats.blocksResearched = broad.blocksResearched;
 	for (const auto& [a, b] : pairs_) stats.fixedPairsSearched += blocks_[a].fixed && blocks_[b].fixed;
 	stats.timeBroadPhase = secondsSince(phase);
+	stats.cpuBroadPhase = processCpuSeconds() - cpu;
 
 	phase = Clock::now();
+	cpu = processCpuSeconds();
 	store_.beginStep();  // the contact store's work, timed with the narrow phase
 	if (internalFacesBlocks_ != blockCount()) {
 		markInternalFaces(blocks_, internalFaces_);
@@ -387,6 +398,7 @@ void World::detectContacts(const IntegratorSettings& settings, StepStatistics& s
 	}
 	stats.contacts = static_cast<int>(store_.contacts().size());
 	stats.timeNarrowPhase = secondsSince(phase);
+	stats.cpuNarrowPhase = processCpuSeconds() - cpu;
 	stats.colliderBytes = static_cast<long>(collider_->memoryBytes());
 	std::size_t contactBytes = store_.memoryBytes() + capacityBytes(pairs_) + capacityBytes(pairResults_) +
 	                           capacityBytes(pairWork_) + capacityBytes(points_);
