@@ -475,15 +475,18 @@ def evaluateTargets(summaries, slenderScenes, strategies):
         applies = scene in slenderScenes
         msc, dess, nbs, isc = (by.get((scene, k)) for k in ('MSC', 'DESS', 'NBS', 'InsertionSortCollider'))
         cachedMsc, cachedDess = (by.get((scene, k + ':reuseCandidatePairs=1')) for k in ('MSC', 'DESS'))
-        if cachedMsc and cachedDess:
-            add(scene, 'MSC detection time / DESS, both with their pair caches', 0.7,
-                _ratio(cachedMsc['mean']['detectionMs'], cachedDess['mean']['detectionMs']),
-                'as a run with the integrator\'s default reuseCandidatePairs=True: a block is searched again '
-                'only when it leaves its cached box', False)
-        if cachedMsc and isc:
-            add(scene, 'MSC with its pair cache / YADE InsertionSortCollider + polyhedra narrow phase', 1 / 20.0,
-                _ratio(cachedMsc['mean']['detectionMs'], isc['mean']['detectionMs']),
-                'both as a user runs them: DDA\'s default pair cache, YADE with the verletDist given', False)
+
+        def meanRatio(name, limit, ours, theirs, key, what, judged):
+            """A target on the ratio of two summaries' means of `key` (when both ran and have it)."""
+            if ours and theirs and key in ours['mean'] and key in theirs['mean']:
+                add(scene, name, limit, _ratio(ours['mean'][key], theirs['mean'][key]), what, judged)
+
+        meanRatio('MSC detection time / DESS, both with their pair caches', 0.7, cachedMsc, cachedDess, 'detectionMs',
+                  'as a run with the integrator\'s default reuseCandidatePairs=True: a block is searched again only '
+                  'when it leaves its cached box', False)
+        meanRatio('MSC with its pair cache / YADE InsertionSortCollider + polyhedra narrow phase', 1 / 20.0, cachedMsc,
+                  isc, 'detectionMs', 'both as a user runs them: DDA\'s default pair cache, YADE with the verletDist '
+                  'given', False)
         if msc:
             add(scene, 'MSC candidate pairs / pairs within d0', 2.0,
                 _ratio(msc['mean']['candidatePairs'], msc['mean']['contactPairs']),
@@ -497,11 +500,9 @@ def evaluateTargets(summaries, slenderScenes, strategies):
                 'stats()["subUnitPairs"]: the paper\'s Va x Fb + Vb x Fa + Ea x Eb over the candidates', applies)
             add(scene, 'MSC detection time / DESS', 0.7, _ratio(msc['mean']['detectionMs'], dess['mean']['detectionMs']),
                 'broad + narrow phase ms per step, one thread each', applies)
-            if 'detectionCpuMs' in msc['mean'] and 'detectionCpuMs' in dess['mean']:
-                add(scene, 'MSC detection CPU time / DESS', 0.7,
-                    _ratio(msc['mean']['detectionCpuMs'], dess['mean']['detectionCpuMs']),
-                    'the same, in process CPU time (stats()["cpuTime"]): one thread, so the work without this '
-                    'machine\'s waits', applies)
+            meanRatio('MSC detection CPU time / DESS', 0.7, msc, dess, 'detectionCpuMs',
+                      'the same, in process CPU time (stats()["cpuTime"]): one thread, so the work without this '
+                      'machine\'s waits', applies)
         if msc and nbs:
             add(scene, 'MSC sub-unit tests / NBS', 1 / 3.0,
                 _ratio(msc['mean'].get('subUnitTests', 0), nbs['mean'].get('subUnitTests', 0)),
