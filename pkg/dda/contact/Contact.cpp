@@ -36,7 +36,9 @@ const char* contactStateName(ContactState state) {
 }
 
 void ContactStore::beginStep() {
-	previous_.swap(current_);
+	previous_.clear();
+	previous_.reserve(current_.size());
+	for (const Contact& contact : current_) previous_.push_back({contact.key, contact.history});
 	current_.clear();
 	previousIndex_.clear();
 	byFeature1_.clear();
@@ -144,7 +146,8 @@ std::size_t mapBytes(const Map& map) {
 }  // namespace
 
 std::size_t ContactStore::memoryBytes() const {
-	std::size_t bytes = (current_.capacity() + previous_.capacity()) * sizeof(Contact) + claimed_.capacity() +
+	std::size_t bytes = current_.capacity() * sizeof(Contact) + previous_.capacity() * sizeof(PreviousContact) +
+	                    claimed_.capacity() +
 	                    mapBytes(previousIndex_) + mapBytes(byFeature1_) + mapBytes(entrances_) +
 	                    mapBytes(previousEntrances_);
 	for (const auto& entry : byFeature1_) bytes += entry.second.capacity() * sizeof(int);

@@ -112,7 +112,13 @@ public:
 
 private:
 	std::vector<Contact> current_;
-	std::vector<Contact> previous_;
+	// The last step's contacts as add() reads them: identity and history
+	// only (144 of a Contact's 800 bytes).
+	struct PreviousContact {
+		ContactKey key;
+		ContactHistory history;
+	};
+	std::vector<PreviousContact> previous_;
 	std::unordered_map<ContactKey, int, ContactKeyHash> previousIndex_;
 	// previous contacts by (blocks, kind, feature of i), feature2 = -1
 	std::unordered_map<ContactKey, std::vector<int>, ContactKeyHash> byFeature1_;
