@@ -378,6 +378,7 @@ def worker(task):
             if 'memory' in s:      # heap the broad phase and the contacts hold [MB]
                 row['colliderMB'] = s['memory']['collider'] / 2.0 ** 20
                 row['contactsMB'] = s['memory']['contacts'] / 2.0 ** 20
+                row['narrowPhaseMB'] = s['memory'].get('narrowPhase', 0) / 2.0 ** 20
             if step == 0:        # the scene must not start interpenetrating: smallest sub-contact gap
                 gaps = [c[9] for c in ddaScene.current().core.contacts()]
                 record['firstStepGaps'] = dict(min=min(gaps) if gaps else None, negative=sum(1 for g in gaps if g < 0),
@@ -518,9 +519,12 @@ def evaluateTargets(summaries, slenderScenes, strategies):
                 '"well under" read as at most half; whole-process peak RSS (as the issue\'s 740 MB), each run in its '
                 'own process', applies)
             if 'colliderMB' in msc['mean']:
-                add(scene, 'MSC detection heap (collider + contacts) / YADE ISC memory added by stepping', None,
-                    _ratio(msc['mean']['colliderMB'] + msc['mean']['contactsMB'], isc['steppingAboveLoadedMB']),
-                    'information: stats()["memory"] (the arrays MSC and the contact store hold) against what '
+                add(scene, 'MSC detection heap (collider + contacts + narrow phase) / YADE ISC memory added by '
+                    'stepping', None,
+                    _ratio(msc['mean']['colliderMB'] + msc['mean']['contactsMB'] + msc['mean'].get('narrowPhaseMB', 0),
+                           isc['steppingAboveLoadedMB']),
+                    'information: stats()["memory"] (the arrays MSC, the contact store and the narrow phase hold) '
+                    'against what '
                     'YADE\'s collider, interactions and laws added to its RSS', False)
             add(scene, 'MSC / YADE ISC memory added by stepping (peak - loaded)', None,
                 _ratio(msc['steppingAboveLoadedMB'], isc['steppingAboveLoadedMB']),
@@ -821,8 +825,9 @@ def main():
         '(Ig2_Polyhedra_Polyhedra_PolyhedraGeom with CGAL, plus Ip2 and the Volumetric law, timed together); '
         'candidatePairs = len(O.interactions) (unwidened box overlaps), realInteractions = countReal() '
         '(overlapping volumes). YADE has no contact distance, so it has no "pairs within d0" of its own.',
-        'colliderMB and contactsMB (DDA): stats()["memory"], the heap the broad phase and the contact store '
-        '(with the previous step\'s contacts, kept for their history) hold after the detection.',
+        'colliderMB, contactsMB and narrowPhaseMB (DDA): stats()["memory"], the heap the broad phase, the contact '
+        'store (with the previous step\'s contacts, kept for their history) and the narrow phase (per-block planes, '
+        'per-pair results) hold after the detection.',
         'Memory: each run is its own process. memory.bareYadeMB = RSS after importing YADE and yade_dda; '
         'loadedMB = RSS with the scene loaded (bodies in O.bodies, DDA blocks in the core) but not stepped; '
         'peakWhileSteppingMB = VmHWM after resetting it at load (clear_refs), so steppingAboveLoadedMB is what '

@@ -261,6 +261,7 @@ py::dict lastStep(const SceneLink& s) {
 	py::dict memory;
 	memory["collider"] = st.colliderBytes;
 	memory["contacts"] = st.contactBytes;
+	memory["narrowPhase"] = st.narrowPhaseBytes;
 	d["memory"] = memory;
 	d["contactPairs"] = st.contactPairs;
 	d["contacts"] = st.contacts;

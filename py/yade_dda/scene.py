@@ -183,8 +183,9 @@ def stats():
     ``maxPenetration`` [m] (deepest closed contact), ``components`` and
     ``largestComponent`` (independent systems solved, blocks in the largest).
     ``memory``: heap bytes held after the detection: ``collider`` (the broad
-    phase's arrays: boxes, shells, grid, caches) and ``contacts`` (the contact
-    store with the previous step's contacts, and the per-pair results).
+    phase's arrays: boxes, shells, grid, caches), ``contacts`` (the contact
+    store with the previous step's contacts kept for their history) and
+    ``narrowPhase`` (its per-block planes and per-pair results).
     ``time``: wall seconds per phase: broadPhase, narrowPhase, assembly,
     solve, update, core, sync. ``cpuTime``: the process's CPU seconds (all
     threads) in broadPhase and narrowPhase; with one thread it is the work

@@ -575,9 +575,10 @@ TEST(MSCCollider, LinkedNarrowPhaseEqualsTheFullSearchAndFallsBackWhenDeep) {
 }
 
 TEST(MSCCollider, MemoryStatisticsCountTheArraysHeld) {
-	// stats' colliderBytes and contactBytes hold at least the arrays every
-	// strategy must keep (a box per block or shell; a Contact per sub-contact)
-	// and MSC's shells cost more than DESS's single boxes.
+	// stats' colliderBytes, contactBytes and narrowPhaseBytes hold at least
+	// the arrays every strategy must keep (a box per block or shell; a
+	// Contact per sub-contact; a result per candidate pair) and MSC's shells
+	// cost more than DESS's single boxes.
 	const auto run = [](std::unique_ptr<Collider> collider) {
 		World world = randomMscScene(120, 9);
 		world.setCollider(std::move(collider));
@@ -604,4 +605,7 @@ TEST(MSCCollider, MemoryStatisticsCountTheArraysHeld) {
 	EXPECT_GE(msc.colliderBytes, static_cast<long>(msc.shells * 2 * sizeof(Eigen::AlignedBox3d)));
 	EXPECT_GT(msc.colliderBytes, dess.colliderBytes);
 	EXPECT_GE(nbs.colliderBytes, static_cast<long>(nbs.blocks * (sizeof(Vector3) + sizeof(double))));
+	// The narrow phase keeps at least one result slot per candidate pair.
+	for (const StepStatistics* s : {&dess, &msc, &nbs})
+		EXPECT_GE(s->narrowPhaseBytes, static_cast<long>(s->candidatePairs * sizeof(std::optional<PairContacts>)));
 }

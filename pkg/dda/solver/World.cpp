@@ -400,11 +400,14 @@ void World::detectContacts(const IntegratorSettings& settings, StepStatistics& s
 	stats.timeNarrowPhase = secondsSince(phase);
 	stats.cpuNarrowPhase = processCpuSeconds() - cpu;
 	stats.colliderBytes = static_cast<long>(collider_->memoryBytes());
-	std::size_t contactBytes = store_.memoryBytes() + capacityBytes(pairs_) + capacityBytes(pairResults_) +
-	                           capacityBytes(pairWork_) + capacityBytes(points_);
+	stats.contactBytes = static_cast<long>(store_.memoryBytes());
+	std::size_t narrowBytes = capacityBytes(pairs_) + capacityBytes(pairResults_) + capacityBytes(pairWork_) +
+	                          capacityBytes(points_) + capacityBytes(planes_) + capacityBytes(inPair_) +
+	                          capacityBytes(planeBlocks_) + capacityBytes(diagonals_);
 	for (const auto& result : pairResults_)
-		if (result) contactBytes += capacityBytes(result->contacts);
-	stats.contactBytes = static_cast<long>(contactBytes);
+		if (result) narrowBytes += capacityBytes(result->contacts);
+	for (const BlockPlanes& planes : planes_) narrowBytes += capacityBytes(planes.faces) + capacityBytes(planes.edges);
+	stats.narrowPhaseBytes = static_cast<long>(narrowBytes);
 }
 
 void World::buildSystemStructure(int movingBlocks, StepStatistics& stats) {
