@@ -1089,6 +1089,9 @@ std::optional<PairContacts> detectPairContacts(const BlockGeometry& blockA, cons
 	}
 	out.type = structuralType(a, featureOf(a, pointsA, featureTolerance), b, featureOf(b, pointsB, featureTolerance),
 	                          sinTolerance);
+	// The result is kept until the next step's detection: no spare slots
+	// (most pairs have one or two sub-contacts of the eight reserved).
+	out.contacts.shrink_to_fit();
 	return out;
 }
 
