@@ -258,10 +258,11 @@ py::dict lastStep(const SceneLink& s) {
 	d["subUnitPairs"] = st.subUnitPairs;
 	d["subUnitTests"] = st.subUnitTests;
 	d["fullSearchPairs"] = st.fullSearchPairs;
+	const World::MemoryUse use = s.world.memoryUse();
 	py::dict memory;
-	memory["collider"] = st.colliderBytes;
-	memory["contacts"] = st.contactBytes;
-	memory["narrowPhase"] = st.narrowPhaseBytes;
+	memory["collider"] = use.collider;
+	memory["contacts"] = use.contacts;
+	memory["narrowPhase"] = use.narrowPhase;
 	d["memory"] = memory;
 	d["contactPairs"] = st.contactPairs;
 	d["contacts"] = st.contacts;

@@ -575,21 +575,26 @@ TEST(MSCCollider, LinkedNarrowPhaseEqualsTheFullSearchAndFallsBackWhenDeep) {
 }
 
 TEST(MSCCollider, MemoryStatisticsCountTheArraysHeld) {
-	// stats' colliderBytes, contactBytes and narrowPhaseBytes hold at least
-	// the arrays every strategy must keep (a box per block or shell; a
+	// World::memoryUse's collider, contacts and narrowPhase bytes hold at
+	// least the arrays every strategy must keep (a box per block or shell; a
 	// Contact per sub-contact; a result per candidate pair) and MSC's shells
 	// cost more than DESS's single boxes.
+	struct Run {
+		StepStatistics stats;
+		World::MemoryUse memory;
+	};
 	const auto run = [](std::unique_ptr<Collider> collider) {
 		World world = randomMscScene(120, 9);
 		world.setCollider(std::move(collider));
 		IntegratorSettings settings;
 		settings.maxTimeStep = 1e-4;
 		world.step(settings);
-		return world.lastStep();
+		return Run{world.lastStep(), world.memoryUse()};
 	};
-	const StepStatistics dess = run(std::make_unique<DESSCollider>());
-	const StepStatistics msc = run(std::make_unique<MSCCollider>());
-	const StepStatistics nbs = run(std::make_unique<NBSCollider>());
+	const Run dessRun = run(std::make_unique<DESSCollider>());
+	const Run mscRun = run(std::make_unique<MSCCollider>());
+	const Run nbsRun = run(std::make_unique<NBSCollider>());
+	const StepStatistics &dess = dessRun.stats, &msc = mscRun.stats, &nbs = nbsRun.stats;
 	ASSERT_GT(dess.contacts, 10);
 	for (const StepStatistics* s : {&dess, &msc, &nbs}) {
 		// The phases' process CPU time: some was spent, and not more than the
@@ -598,14 +603,15 @@ TEST(MSCCollider, MemoryStatisticsCountTheArraysHeld) {
 		EXPECT_GT(s->cpuNarrowPhase, 0);
 		EXPECT_GE(s->cpuBroadPhase, 0);
 		EXPECT_LE(s->cpuBroadPhase + s->cpuNarrowPhase, s->timeTotal * 4 + 0.02);
-		EXPECT_GE(s->contactBytes, static_cast<long>(s->contacts * sizeof(Contact)));
-		EXPECT_LT(s->contactBytes, static_cast<long>(s->contacts * sizeof(Contact)) * 20 + (1 << 20));
 	}
-	EXPECT_GE(dess.colliderBytes, static_cast<long>(dess.blocks * sizeof(Eigen::AlignedBox3d)));
-	EXPECT_GE(msc.colliderBytes, static_cast<long>(msc.shells * 2 * sizeof(Eigen::AlignedBox3d)));
-	EXPECT_GT(msc.colliderBytes, dess.colliderBytes);
-	EXPECT_GE(nbs.colliderBytes, static_cast<long>(nbs.blocks * (sizeof(Vector3) + sizeof(double))));
-	// The narrow phase keeps at least one result slot per candidate pair.
-	for (const StepStatistics* s : {&dess, &msc, &nbs})
-		EXPECT_GE(s->narrowPhaseBytes, static_cast<long>(s->candidatePairs * sizeof(std::optional<PairContacts>)));
+	for (const Run* r : {&dessRun, &mscRun, &nbsRun}) {
+		EXPECT_GE(r->memory.contacts, r->stats.contacts * sizeof(Contact));
+		EXPECT_LT(r->memory.contacts, r->stats.contacts * sizeof(Contact) * 20 + (1 << 20));
+		// The narrow phase keeps at least one result slot per candidate pair.
+		EXPECT_GE(r->memory.narrowPhase, r->stats.candidatePairs * sizeof(std::optional<PairContacts>));
+	}
+	EXPECT_GE(dessRun.memory.collider, dess.blocks * sizeof(Eigen::AlignedBox3d));
+	EXPECT_GE(mscRun.memory.collider, msc.shells * 2 * sizeof(Eigen::AlignedBox3d));
+	EXPECT_GT(mscRun.memory.collider, dessRun.memory.collider);
+	EXPECT_GE(nbsRun.memory.collider, nbs.blocks * (sizeof(Vector3) + sizeof(double)));
 }

@@ -331,40 +331,29 @@ long MSCCollider::gridSearch(const std::vector<Block>& blocks, const std::vector
 	// blocks themselves are large and far apart in memory).
 	shellFixed_.resize(shellTotal);
 	for (int s = 0; s < shellTotal; ++s) shellFixed_[s] = blocks[shellBlock_[s]].fixed;
+	// Compares shells s and t if `mine` (this is where the pair is compared):
+	// a test when their blocks differ and are not both fixed, a shell pair
+	// when their boxes meet too. The conditions are evaluated together,
+	// without a branch each (they are unpredictable and the tests cheap).
 	long tests = 0;
-	const auto compare = [&](int s, int t) {
+	const auto compare = [&](int s, int t, bool mine) {
 		const int a = shellBlock_[s], b = shellBlock_[t];
-		if (a == b || (shellFixed_[s] && shellFixed_[t])) return;
-		++tests;
-		if (!boxes[s].intersects(boxes[t])) return;
-		out.push_back(a < b ? ShellPair{a, b, s, t} : ShellPair{b, a, t, s});
+		const bool pair = (a != b) & !(static_cast<bool>(shellFixed_[s]) & static_cast<bool>(shellFixed_[t]));
+		const Vector3 &lowS = boxes[s].min(), &highS = boxes[s].max();
+		const Vector3 &lowT = boxes[t].min(), &highT = boxes[t].max();
+		const bool meet = (lowS.x() <= highT.x()) & (lowT.x() <= highS.x()) & (lowS.y() <= highT.y()) &
+		                  (lowT.y() <= highS.y()) & (lowS.z() <= highT.z()) & (lowT.z() <= highS.z());
+		tests += mine & pair;
+		if (mine & pair & meet) out.push_back(a < b ? ShellPair{a, b, s, t} : ShellPair{b, a, t, s});
 	};
-	// The shells of cell `here`: cellShells_[first, last), ascending. The
-	// three conditions (this pair's cell, two blocks not both fixed, boxes
-	// that meet) are evaluated together, without a branch each (they are
-	// unpredictable and the tests cheap).
+	// The shells of cell `here`: cellShells_[first, last), ascending; a pair
+	// is compared in the cell of the max of its lowest cells only.
 	const auto scanCell = [&](std::uint64_t here, std::size_t first, std::size_t last) {
-		for (std::size_t p = first; p < last; ++p) {
-			const int s = cellShells_[p];
-			const int a = shellBlock_[s];
-			const bool fixedA = shellFixed_[s];
-			const Vector3& lowS = boxes[s].min();
-			const Vector3& highS = boxes[s].max();
+		for (std::size_t p = first; p < last; ++p)
 			for (std::size_t q = p + 1; q < last; ++q) {
-				const int t = cellShells_[q];
-				const bool mine = key(cellLow_[s].max(cellLow_[t])) == here;  // else compared in another cell
-				const bool pair = (shellBlock_[t] != a) & !(fixedA & static_cast<bool>(shellFixed_[t]));
-				const Vector3& lowT = boxes[t].min();
-				const Vector3& highT = boxes[t].max();
-				const bool meet = (lowS.x() <= highT.x()) & (lowT.x() <= highS.x()) & (lowS.y() <= highT.y()) &
-				                  (lowT.y() <= highS.y()) & (lowS.z() <= highT.z()) & (lowT.z() <= highS.z());
-				tests += mine & pair;
-				if (mine & pair & meet) {
-					const int b = shellBlock_[t];
-					out.push_back(a < b ? ShellPair{a, b, s, t} : ShellPair{b, a, t, s});
-				}
+				const int s = cellShells_[p], t = cellShells_[q];
+				compare(s, t, key(cellLow_[s].max(cellLow_[t])) == here);
 			}
-		}
 	};
 	const auto forEachCellOf = [&](int s, const auto& visit) {
 		const Cell& lo = cellLow_[s];
@@ -405,7 +394,7 @@ long MSCCollider::gridSearch(const std::vector<Block>& blocks, const std::vector
 	}
 	for (int s : oversize_)
 		for (int t = 0; t < shellTotal; ++t)
-			if (t != s && (!isOversize_[t] || s < t)) compare(s, t);
+			if (t != s && (!isOversize_[t] || s < t)) compare(s, t, true);
 	return tests;
 }
 

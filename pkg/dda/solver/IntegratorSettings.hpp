@@ -95,13 +95,6 @@ struct StepStatistics {
 	long subUnitPairs = 0;           // vertex-face plus edge-edge sub-unit pairs the candidates offer
 	long subUnitTests = 0;           // vertex-face plane tests and edge-edge tests the narrow phase made
 	long fullSearchPairs = 0;        // MSC pairs searched again with every sub-unit (deep penetration)
-	// Heap held after the detection [bytes]: the broad phase's arrays
-	// (Collider::memoryBytes), the contact store (with the last step's
-	// contacts kept for their history), and the narrow phase's work arrays
-	// (per-block planes, per-pair results).
-	long colliderBytes = 0;
-	long contactBytes = 0;
-	long narrowPhaseBytes = 0;
 	int contactPairs = 0;            // block pairs within d0
 	int contacts = 0;                // vertex-face and edge-edge sub-contacts
 	int closedContacts = 0;          // sliding or locked at the end of the step

@@ -399,15 +399,19 @@ void World::detectContacts(const IntegratorSettings& settings, StepStatistics& s
 	stats.contacts = static_cast<int>(store_.contacts().size());
 	stats.timeNarrowPhase = secondsSince(phase);
 	stats.cpuNarrowPhase = processCpuSeconds() - cpu;
-	stats.colliderBytes = static_cast<long>(collider_->memoryBytes());
-	stats.contactBytes = static_cast<long>(store_.memoryBytes());
-	std::size_t narrowBytes = capacityBytes(pairs_) + capacityBytes(pairResults_) + capacityBytes(pairWork_) +
-	                          capacityBytes(points_) + capacityBytes(planes_) + capacityBytes(inPair_) +
-	                          capacityBytes(planeBlocks_) + capacityBytes(diagonals_);
+}
+
+World::MemoryUse World::memoryUse() const {
+	MemoryUse use;
+	use.collider = collider_->memoryBytes();
+	use.contacts = store_.memoryBytes();
+	use.narrowPhase = capacityBytes(pairs_) + capacityBytes(pairResults_) + capacityBytes(pairWork_) +
+	                  capacityBytes(points_) + capacityBytes(planes_) + capacityBytes(inPair_) +
+	                  capacityBytes(planeBlocks_) + capacityBytes(diagonals_);
 	for (const auto& result : pairResults_)
-		if (result) narrowBytes += capacityBytes(result->contacts);
-	for (const BlockPlanes& planes : planes_) narrowBytes += capacityBytes(planes.faces) + capacityBytes(planes.edges);
-	stats.narrowPhaseBytes = static_cast<long>(narrowBytes);
+		if (result) use.narrowPhase += capacityBytes(result->contacts);
+	for (const BlockPlanes& planes : planes_) use.narrowPhase += capacityBytes(planes.faces) + capacityBytes(planes.edges);
+	return use;
 }
 
 void World::buildSystemStructure(int movingBlocks, StepStatistics& stats) {

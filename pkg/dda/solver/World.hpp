@@ -52,6 +52,15 @@ public:
 	// Advances all blocks by one accepted step; returns the dt taken [s].
 	double step(const IntegratorSettings& settings);
 	const StepStatistics& lastStep() const { return stats_; }
+	// Heap held now [bytes] (computed when asked, not every step): the broad
+	// phase's arrays (Collider::memoryBytes), the contact store (with the last
+	// step's contacts kept for their history), and the narrow phase's work
+	// arrays (per-block planes, per-pair results). Between steps they are
+	// what the last detection left.
+	struct MemoryUse {
+		std::size_t collider = 0, contacts = 0, narrowPhase = 0;
+	};
+	MemoryUse memoryUse() const;
 	double time() const { return time_; }
 	long steps() const { return steps_; }
 	// Sub-contacts of the last step, with their state at its end.
