@@ -106,3 +106,64 @@ TEST(ContactStore, EntranceFeaturesCarryOneStep) {
 	store.beginStep();  // not set again: forgotten
 	EXPECT_EQ(store.previousEntrance(1, 4).kind, EntranceFeature::None);
 }
+
+// Many contacts (the hash index probes past collisions): each one, added
+// again in another order, inherits its own history and no other; a vertex
+// that slid onto a face next to two old ones takes the one added first.
+TEST(ContactStore, ManyContactsEachInheritTheirOwn) {
+	const ConvexPolyhedron cube = unitCube();
+	ContactStore store;
+	const SubContact geometry;
+	std::vector<ContactKey> keys;
+	for (int i = 0; i < 40; ++i)
+		for (int j = i + 1; j < 40; j += 3)
+			for (int v = 0; v < 8; v += 3) keys.push_back({i, j, ContactKind::VertexFace, v, (i + j + v) % 6});
+	store.beginStep();
+	for (std::size_t k = 0; k < keys.size(); ++k) store.add(keys[k], ContactType::VertexFace, geometry, cube, cube).history.normalForce = static_cast<double>(k);
+	store.beginStep();
+	for (std::size_t k = keys.size(); k-- > 0;) {
+		const Contact& c = store.add(keys[k], ContactType::VertexFace, geometry, cube, cube);
+		ASSERT_FALSE(c.isNew);
+		EXPECT_EQ(c.history.normalForce, static_cast<double>(k));
+	}
+	EXPECT_FALSE(store.add({0, 99, ContactKind::VertexFace, 0, 0}, ContactType::VertexFace, geometry, cube, cube).history.normalForce > 0);
+
+	// Faces f and `opposite` are both adjacent to `neighbour`: the one added
+	// first is the predecessor, whichever it is.
+	int f, neighbour, opposite;
+	faces(cube, f, neighbour, opposite);
+	for (const bool fFirst : {true, false}) {
+		store.clear();
+		store.beginStep();
+		for (const int face : fFirst ? std::vector<int>{f, opposite} : std::vector<int>{opposite, f})
+			store.add({1, 2, ContactKind::VertexFace, 3, face}, ContactType::VertexFace, geometry, cube, cube)
+			    .history.normalForce = face == f ? 2 : 1;
+		store.beginStep();
+		EXPECT_EQ(store.add({1, 2, ContactKind::VertexFace, 3, neighbour}, ContactType::VertexFace, geometry, cube, cube)
+		              .history.normalForce, fFirst ? 2 : 1);
+	}
+}
+
+// Entrances set out of order or twice in a step: the last one set counts,
+// and they are saved sorted by pair.
+TEST(ContactStore, EntrancesSetOutOfOrderOrTwice) {
+	ContactStore store;
+	store.beginStep();
+	EntranceFeature e1, e2, e3;
+	e1.kind = EntranceFeature::FaceOfA;
+	e1.feature = 1;
+	e2.kind = EntranceFeature::FaceOfB;
+	e2.feature = 2;
+	e3.kind = EntranceFeature::EdgePair;
+	e3.feature = 3;
+	e3.other = 4;
+	store.setEntrance(5, 9, e1);
+	store.setEntrance(2, 7, e2);
+	store.setEntrance(5, 9, e3);
+	ASSERT_EQ(store.entrances().size(), 2u);
+	EXPECT_LT(store.entrances()[0].first, store.entrances()[1].first);
+	store.beginStep();
+	EXPECT_TRUE(store.previousEntrance(5, 9) == e3);
+	EXPECT_TRUE(store.previousEntrance(2, 7) == e2);
+	EXPECT_EQ(store.previousEntrance(2, 9).kind, EntranceFeature::None);
+}

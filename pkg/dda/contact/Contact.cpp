@@ -17,6 +17,16 @@ bool facesAdjacent(const ConvexPolyhedron& shape, int f, int g) {
 	return false;
 }
 
+template <class T>
+std::size_t capacityBytes(const std::vector<T>& v) {
+	return v.capacity() * sizeof(T);
+}
+
+// Same blocks, kind and first feature (the second is not compared).
+bool sameFeature1(const ContactKey& a, const ContactKey& b) {
+	return a.blockI == b.blockI && a.blockJ == b.blockJ && a.kind == b.kind && a.feature1 == b.feature1;
+}
+
 // Edges e and g of a shape share a corner.
 bool edgesAdjacent(const ConvexPolyhedron& shape, int e, int g) {
 	const auto& a = shape.edges[e];
@@ -35,53 +45,90 @@ const char* contactStateName(ContactState state) {
 	return "?";
 }
 
+void ContactStore::FlatIndex::reset(std::size_t entries) {
+	std::size_t size = 16;
+	while (size < 2 * entries) size *= 2;
+	slots.assign(size, -1);
+	mask = size - 1;
+}
+
 void ContactStore::beginStep() {
 	previous_.clear();
 	previous_.reserve(current_.size());
 	for (const Contact& contact : current_) previous_.push_back({contact.key, contact.history});
 	current_.clear();
-	previousIndex_.clear();
-	byFeature1_.clear();
-	for (int k = 0; k < static_cast<int>(previous_.size()); ++k) {
+	const int n = static_cast<int>(previous_.size());
+	previousIndex_.reset(previous_.size());
+	byFeature1_.reset(previous_.size());
+	sameFeature1_.assign(previous_.size(), -1);
+	// Exact keys in ascending order (the first of equal keys is kept); partial
+	// keys in descending order, each becoming its chain's head, so chains
+	// ascend.
+	for (int k = 0; k < n; ++k) {
+		const ContactKey& key = previous_[k].key;
+		for (std::size_t h = ContactKeyHash{}(key) & previousIndex_.mask;; h = (h + 1) & previousIndex_.mask) {
+			int& slot = previousIndex_.slots[h];
+			if (slot < 0) slot = k;
+			if (previous_[slot].key == key) break;
+		}
+	}
+	for (int k = n - 1; k >= 0; --k) {
 		ContactKey partial = previous_[k].key;
-		previousIndex_.emplace(partial, k);
 		partial.feature2 = -1;
-		byFeature1_[partial].push_back(k);
+		for (std::size_t h = ContactKeyHash{}(partial) & byFeature1_.mask;; h = (h + 1) & byFeature1_.mask) {
+			int& slot = byFeature1_.slots[h];
+			if (slot >= 0 && !sameFeature1(previous_[slot].key, partial)) continue;
+			sameFeature1_[k] = slot;
+			slot = k;
+			break;
+		}
 	}
 	claimed_.assign(previous_.size(), 0);
+	if (!entrancesSorted_) normalize(entrances_);
 	previousEntrances_.swap(entrances_);
 	entrances_.clear();
+	entrancesSorted_ = true;
+}
+
+int ContactStore::previousIndex(const ContactKey& key) const {
+	for (std::size_t h = ContactKeyHash{}(key) & previousIndex_.mask;; h = (h + 1) & previousIndex_.mask) {
+		const int slot = previousIndex_.slots[h];
+		if (slot < 0 || previous_[slot].key == key) return slot;
+	}
+}
+
+int ContactStore::firstWithFeature1(ContactKey partial) const {
+	partial.feature2 = -1;
+	for (std::size_t h = ContactKeyHash{}(partial) & byFeature1_.mask;; h = (h + 1) & byFeature1_.mask) {
+		const int slot = byFeature1_.slots[h];
+		if (slot < 0 || sameFeature1(previous_[slot].key, partial)) return slot;
+	}
 }
 
 Contact& ContactStore::add(const ContactKey& key, ContactType pairType, const SubContact& geometry,
                            const ConvexPolyhedron& shapeI, const ConvexPolyhedron& shapeJ) {
 	(void)shapeI;
-	Contact contact;
+	Contact& contact = current_.emplace_back();
 	contact.key = key;
 	contact.pairType = pairType;
 	contact.geometry = geometry;
+	if (previous_.empty()) return contact;
 
 	int predecessor = -1;
-	const auto exact = previousIndex_.find(key);
-	if (exact != previousIndex_.end() && !claimed_[exact->second]) {
-		predecessor = exact->second;
+	const int exact = previousIndex(key);
+	if (exact >= 0 && !claimed_[exact]) {
+		predecessor = exact;
 	} else {
 		// The same vertex (or first edge) of block i against a neighbour of the
 		// old face (or second edge) of block j.
-		ContactKey partial = key;
-		partial.feature2 = -1;
-		const auto candidates = byFeature1_.find(partial);
-		if (candidates != byFeature1_.end()) {
-			for (int k : candidates->second) {
-				if (claimed_[k]) continue;
-				const int oldFeature = previous_[k].key.feature2;
-				const bool neighbour = key.kind == ContactKind::VertexFace
-				                           ? facesAdjacent(shapeJ, oldFeature, key.feature2)
-				                           : edgesAdjacent(shapeJ, oldFeature, key.feature2);
-				if (neighbour) {
-					predecessor = k;
-					break;
-				}
+		for (int k = firstWithFeature1(key); k >= 0; k = sameFeature1_[k]) {
+			if (claimed_[k]) continue;
+			const int oldFeature = previous_[k].key.feature2;
+			const bool neighbour = key.kind == ContactKind::VertexFace ? facesAdjacent(shapeJ, oldFeature, key.feature2)
+			                                                           : edgesAdjacent(shapeJ, oldFeature, key.feature2);
+			if (neighbour) {
+				predecessor = k;
+				break;
 			}
 		}
 	}
@@ -89,9 +136,9 @@ Contact& ContactStore::add(const ContactKey& key, ContactType pairType, const Su
 	if (predecessor < 0 && key.kind == ContactKind::EdgeEdge) {
 		// The same two edges with the roles of i and j exchanged (the pair's
 		// entrance moved from a face of one block to the crossing edges, or back).
-		const auto reversed = previousIndex_.find(ContactKey{key.blockJ, key.blockI, key.kind, key.feature2, key.feature1});
-		if (reversed != previousIndex_.end() && !claimed_[reversed->second]) {
-			predecessor = reversed->second;
+		const int reversed = previousIndex(ContactKey{key.blockJ, key.blockI, key.kind, key.feature2, key.feature1});
+		if (reversed >= 0 && !claimed_[reversed]) {
+			predecessor = reversed;
 			swapped = true;
 		}
 	}
@@ -106,52 +153,67 @@ Contact& ContactStore::add(const ContactKey& key, ContactType pairType, const Su
 			h.shearForce = -h.shearForce;
 		}
 	}
-	current_.push_back(contact);
-	return current_.back();
+	return contact;
 }
 
 const EntranceFeature& ContactStore::previousEntrance(int a, int b) const {
 	static const EntranceFeature none;
-	const auto it = previousEntrances_.find(pairKey(a, b));
-	return it == previousEntrances_.end() ? none : it->second;
+	const std::uint64_t key = pairKey(a, b);
+	const auto it = std::lower_bound(previousEntrances_.begin(), previousEntrances_.end(), key,
+	                                 [](const auto& entry, std::uint64_t k) { return entry.first < k; });
+	return it == previousEntrances_.end() || it->first != key ? none : it->second;
 }
 
 void ContactStore::setEntrance(int a, int b, const EntranceFeature& entrance) {
-	entrances_[pairKey(a, b)] = entrance;
+	const std::uint64_t key = pairKey(a, b);
+	if (!entrances_.empty() && key <= entrances_.back().first) entrancesSorted_ = false;
+	entrances_.emplace_back(key, entrance);
+}
+
+void ContactStore::normalize(std::vector<std::pair<std::uint64_t, EntranceFeature>>& entrances) {
+	std::stable_sort(entrances.begin(), entrances.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+	std::size_t kept = 0;
+	for (const auto& entry : entrances) {
+		if (kept > 0 && entrances[kept - 1].first == entry.first)
+			entrances[kept - 1] = entry;  // set again: the last one counts
+		else
+			entrances[kept++] = entry;
+	}
+	entrances.resize(kept);
+}
+
+const std::vector<std::pair<std::uint64_t, EntranceFeature>>& ContactStore::entrances() const {
+	if (!entrancesSorted_) {
+		normalize(entrances_);
+		entrancesSorted_ = true;
+	}
+	return entrances_;
 }
 
 void ContactStore::restore(std::vector<Contact> contacts,
-                           std::unordered_map<std::uint64_t, EntranceFeature> entrances) {
+                           const std::unordered_map<std::uint64_t, EntranceFeature>& entrances) {
 	clear();
 	current_ = std::move(contacts);
-	entrances_ = std::move(entrances);
+	entrances_.assign(entrances.begin(), entrances.end());
+	entrancesSorted_ = false;
 }
 
 void ContactStore::clear() {
 	current_.clear();
 	previous_.clear();
-	previousIndex_.clear();
-	byFeature1_.clear();
+	previousIndex_.reset(0);
+	byFeature1_.reset(0);
+	sameFeature1_.clear();
 	entrances_.clear();
+	entrancesSorted_ = true;
 	previousEntrances_.clear();
 	claimed_.clear();
 }
 
-namespace {
-template <class Map>
-std::size_t mapBytes(const Map& map) {
-	return map.bucket_count() * sizeof(void*) +
-	       map.size() * (sizeof(void*) + sizeof(typename Map::value_type) + sizeof(std::size_t) + 16);
-}
-}  // namespace
-
 std::size_t ContactStore::memoryBytes() const {
-	std::size_t bytes = current_.capacity() * sizeof(Contact) + previous_.capacity() * sizeof(PreviousContact) +
-	                    claimed_.capacity() +
-	                    mapBytes(previousIndex_) + mapBytes(byFeature1_) + mapBytes(entrances_) +
-	                    mapBytes(previousEntrances_);
-	for (const auto& entry : byFeature1_) bytes += entry.second.capacity() * sizeof(int);
-	return bytes;
+	return capacityBytes(current_) + capacityBytes(previous_) + capacityBytes(claimed_) +
+	       capacityBytes(previousIndex_.slots) + capacityBytes(byFeature1_.slots) + capacityBytes(sameFeature1_) +
+	       capacityBytes(entrances_) + capacityBytes(previousEntrances_);
 }
 
 }  // namespace dda

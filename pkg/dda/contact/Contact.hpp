@@ -100,17 +100,32 @@ public:
 	void setEntrance(int a, int b, const EntranceFeature& entrance);
 
 	void clear();
-	// Heap bytes held: both contact arrays' capacities and the hash maps
-	// (buckets, and per entry its node: a pointer, the entry, the cached hash
-	// and malloc's 16-byte header) [bytes].
+	// Heap bytes held: the capacities of the contact arrays, the indexes of
+	// the previous contacts and the entrance lists [bytes].
 	std::size_t memoryBytes() const;
 
 	// Saving (solver/WorldState.cpp): the current contacts and entrance
-	// features are all a store carries into the next step.
-	const std::unordered_map<std::uint64_t, EntranceFeature>& entrances() const { return entrances_; }
-	void restore(std::vector<Contact> contacts, std::unordered_map<std::uint64_t, EntranceFeature> entrances);
+	// features are all a store carries into the next step. Entrances come
+	// sorted by pair key, one per pair.
+	const std::vector<std::pair<std::uint64_t, EntranceFeature>>& entrances() const;
+	void restore(std::vector<Contact> contacts, const std::unordered_map<std::uint64_t, EntranceFeature>& entrances);
 
 private:
+	// An open-addressing hash index of previous_ (linear probing, a power-of-two
+	// table of indices, -1 empty): no allocation per entry, unlike a node-based
+	// map, and rebuilt in place every step.
+	struct FlatIndex {
+		std::vector<int> slots;
+		std::size_t mask = 0;
+		void reset(std::size_t entries);
+	};
+	// Index into previous_ of the contact with this key, or -1.
+	int previousIndex(const ContactKey& key) const;
+	// The first previous contact with key's blocks, kind and feature1, or -1.
+	int firstWithFeature1(ContactKey key) const;
+	// Sorts entrances by key, keeping the last one set per key.
+	static void normalize(std::vector<std::pair<std::uint64_t, EntranceFeature>>& entrances);
+
 	std::vector<Contact> current_;
 	// The last step's contacts as add() reads them: identity and history
 	// only (144 of a Contact's 800 bytes).
@@ -119,10 +134,16 @@ private:
 		ContactHistory history;
 	};
 	std::vector<PreviousContact> previous_;
-	std::unordered_map<ContactKey, int, ContactKeyHash> previousIndex_;
-	// previous contacts by (blocks, kind, feature of i), feature2 = -1
-	std::unordered_map<ContactKey, std::vector<int>, ContactKeyHash> byFeature1_;
-	std::unordered_map<std::uint64_t, EntranceFeature> entrances_, previousEntrances_;
+	// previous_ by key (the first of equal keys), and by (blocks, kind,
+	// feature of i), feature2 = -1: the first such contact, the others
+	// following by sameFeature1_ in ascending order (-1 ends the chain).
+	FlatIndex previousIndex_, byFeature1_;
+	std::vector<int> sameFeature1_;
+	// Entrance features by pair key: this step's as set (normalized when
+	// read), the last step's sorted.
+	mutable std::vector<std::pair<std::uint64_t, EntranceFeature>> entrances_;
+	mutable bool entrancesSorted_ = true;
+	std::vector<std::pair<std::uint64_t, EntranceFeature>> previousEntrances_;
 	std::vector<char> claimed_;  // previous contacts already inherited this step
 };
 
