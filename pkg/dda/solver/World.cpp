@@ -459,13 +459,18 @@ void World::assembleOwnSystems(const IntegratorSettings& settings, double dt) {
 
 void World::solveAloneBlocks(const IntegratorSettings& settings, double dt) {
 	const int n = static_cast<int>(moving_.size());
-#pragma omp parallel for schedule(static) if (n >= kMinBlocksForThreads)
+	int unsolved = 0;
 	for (int k = 0; k < n; ++k) {
-		if (coupled_.coupled(k)) {
+		if (coupled_.coupled(k))
 			solvedAlone_[k] = 0;  // coupled_.solve writes its solution
-			continue;
-		}
-		if (solvedAlone_[k]) continue;
+		else
+			unsolved += !solvedAlone_[k];
+	}
+	// Threads only for work: each parallel region can wait a scheduler slice
+	// on a loaded machine (kMinBlocksForThreads).
+#pragma omp parallel for schedule(static) if (unsolved >= kMinBlocksForThreads)
+	for (int k = 0; k < n; ++k) {
+		if (coupled_.coupled(k) || solvedAlone_[k]) continue;
 		const Block& block = blocks_[moving_[k]];
 		BlockSystem system;
 		assembleBlock(block, settings, dt, system);
