@@ -263,6 +263,7 @@ py::dict lastStep(const SceneLink& s) {
 	memory["collider"] = use.collider;
 	memory["contacts"] = use.contacts;
 	memory["narrowPhase"] = use.narrowPhase;
+	memory["solver"] = use.solver;
 	d["memory"] = memory;
 	d["contactPairs"] = st.contactPairs;
 	d["contacts"] = st.contacts;

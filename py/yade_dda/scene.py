@@ -185,7 +185,9 @@ def stats():
     ``memory``: heap bytes held after the detection: ``collider`` (the broad
     phase's arrays: boxes, shells, grid, caches), ``contacts`` (the contact
     store with the previous step's contacts kept for their history) and
-    ``narrowPhase`` (its per-block planes and per-pair results).
+    ``narrowPhase`` (its per-block planes and per-pair results); and after
+    the step, ``solver`` (per moving block its solution and motion, the
+    systems of the blocks with springs, the coupled system's blocks).
     ``time``: wall seconds per phase: broadPhase, narrowPhase, assembly,
     solve, update, core, sync. ``cpuTime``: the process's CPU seconds (all
     threads) in broadPhase and narrowPhase; with one thread it is the work

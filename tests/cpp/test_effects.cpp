@@ -3,7 +3,8 @@
 // every step (settling pile, a block arriving at a resting pile, a resting
 // stack); fixed-fixed pairs never searched and MSC shells of fixed blocks
 // built once; no friction terms without friction, no body force without
-// gravity, static analysis (velocityRatio = 0). Counters, not timings.
+// gravity, static analysis (velocityRatio = 0); no stored system for blocks
+// without springs. Counters, not timings.
 #include "dda/collider/Collider.hpp"
 #include "dda/collider/MSCCollider.hpp"
 #include "dda/solver/World.hpp"
@@ -270,4 +271,26 @@ TEST(Effects, NoBodyForceWithoutGravityAndStaticAnalysis) {
 	world.step(settings);
 	EXPECT_TRUE(world.lastStep().staticAnalysis);
 	EXPECT_EQ(world.block(0).centroid, before);
+}
+
+TEST(Effects, FreeBlocksKeepNoStoredSystem) {
+	// A block without closed contacts or fixed points is solved alone, from a
+	// system assembled where it is solved: the solver keeps a solution and a
+	// motion for it, no 12x12 block (before, it kept two: its own system and
+	// the coupled system's copy).
+	World world;
+	Material rock;
+	const int blocks = 50;
+	for (int k = 0; k < blocks; ++k) world.addBlock(orientedBox(Vector3(3.0 * k, 0, 0), Vector3(0.5, 0.5, 0.5), I3), rock, false);
+	IntegratorSettings settings;
+	settings.maxTimeStep = 1e-3;
+	settings.gravity = Vector3(0, 0, -9.81);
+	world.step(settings);
+	EXPECT_EQ(world.lastStep().components, blocks);
+	EXPECT_EQ(world.lastStep().solvedUnknowns, blocks * kBlockDofs);
+	const std::size_t solver = world.memoryUse().solver;
+	EXPECT_GE(solver, blocks * (sizeof(Vector12) + sizeof(BlockMotion)));
+	EXPECT_LT(solver, blocks * sizeof(Matrix12));
+	// Free fall (closed form z = -g t^2 / 2).
+	EXPECT_NEAR(world.block(0).centroid.z(), -0.5 * 9.81 * world.time() * world.time(), 1e-12);
 }

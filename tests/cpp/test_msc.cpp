@@ -575,10 +575,11 @@ TEST(MSCCollider, LinkedNarrowPhaseEqualsTheFullSearchAndFallsBackWhenDeep) {
 }
 
 TEST(MSCCollider, MemoryStatisticsCountTheArraysHeld) {
-	// World::memoryUse's collider, contacts and narrowPhase bytes hold at
-	// least the arrays every strategy must keep (a box per block or shell; a
-	// Contact per sub-contact; a result per candidate pair) and MSC's shells
-	// cost more than DESS's single boxes.
+	// World::memoryUse's collider, contacts, narrowPhase and solver bytes hold
+	// at least the arrays every strategy must keep (a box per block or shell; a
+	// Contact per sub-contact; a result per candidate pair; a solution and a
+	// motion per moving block) and MSC's shells cost more than DESS's single
+	// boxes.
 	struct Run {
 		StepStatistics stats;
 		World::MemoryUse memory;
@@ -609,6 +610,8 @@ TEST(MSCCollider, MemoryStatisticsCountTheArraysHeld) {
 		EXPECT_LT(r->memory.contacts, r->stats.contacts * sizeof(Contact) * 20 + (1 << 20));
 		// The narrow phase keeps at least one result slot per candidate pair.
 		EXPECT_GE(r->memory.narrowPhase, r->stats.candidatePairs * sizeof(std::optional<PairContacts>));
+		// The solver keeps a solution and a motion per moving block.
+		EXPECT_GE(r->memory.solver, r->stats.movingBlocks * (sizeof(Vector12) + sizeof(BlockMotion)));
 	}
 	EXPECT_GE(dessRun.memory.collider, dess.blocks * sizeof(Eigen::AlignedBox3d));
 	EXPECT_GE(mscRun.memory.collider, msc.shells * 2 * sizeof(Eigen::AlignedBox3d));

@@ -3,18 +3,16 @@
 #include <Eigen/Cholesky>
 #include <Eigen/OrderingMethods>
 #include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
 
 #include <algorithm>
 #include <numeric>
 #include <stdexcept>
+#include <string>
 
 namespace dda {
 
 namespace {
-
-std::uint64_t linkKey(int a, int b) {
-	return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
-}
 
 int findRoot(std::vector<int>& parent, int k) {
 	while (parent[k] != k) {
@@ -28,115 +26,147 @@ int findRoot(std::vector<int>& parent, int k) {
 
 void CoupledSystem::build(int movingBlocks, const std::vector<std::pair<int, int>>& links,
                           const std::vector<char>& hasSprings, const std::vector<int>& unknowns) {
-	hasSprings_ = hasSprings;
-	unknowns_ = unknowns;
+	// Union-find over the links. A root is its set's smallest block (a union
+	// hangs the larger root under the smaller), so a block's root is numbered
+	// before the block itself and components come in the order of their
+	// smallest blocks.
 	std::vector<int> parent(movingBlocks);
 	std::iota(parent.begin(), parent.end(), 0);
-	offDiagonalIndex_.clear();
-	offDiagonalPairs_.clear();
 	for (auto [a, b] : links) {
-		if (a == b) continue;
-		const int lo = std::min(a, b), hi = std::max(a, b);
-		if (offDiagonalIndex_.emplace(linkKey(lo, hi), static_cast<int>(offDiagonalPairs_.size())).second)
-			offDiagonalPairs_.emplace_back(lo, hi);
 		const int ra = findRoot(parent, a), rb = findRoot(parent, b);
 		if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
 	}
-	componentOf_.assign(movingBlocks, -1);
-	localIndex_.assign(movingBlocks, -1);
-	components_.clear();
-	std::vector<int> componentOfRoot(movingBlocks, -1);
+	// slot_ holds each coupled block's component first, its slot after the
+	// component sizes are summed into componentStart_.
+	slot_.assign(movingBlocks, -1);
+	componentStart_.assign(1, 0);
 	for (int k = 0; k < movingBlocks; ++k) {
+		if (!hasSprings[k]) continue;
 		const int root = findRoot(parent, k);
-		if (componentOfRoot[root] < 0) {
-			componentOfRoot[root] = static_cast<int>(components_.size());
-			components_.emplace_back();
+		if (root == k) {
+			slot_[k] = components();
+			componentStart_.push_back(0);
+		} else {
+			slot_[k] = slot_[root];
 		}
-		const int c = componentOfRoot[root];
-		componentOf_[k] = c;
-		localIndex_[k] = static_cast<int>(components_[c].size());
-		components_[c].push_back(k);
+		++componentStart_[slot_[k] + 1];
 	}
-	componentLinks_.assign(components_.size(), {});
-	for (int slot = 0; slot < static_cast<int>(offDiagonalPairs_.size()); ++slot)
-		componentLinks_[componentOf_[offDiagonalPairs_[slot].first]].push_back(slot);
-	offDiagonal_.resize(offDiagonalPairs_.size());
-	componentUnknowns_.assign(components_.size(), 0);
-	diagonal_.resize(movingBlocks);
-	force_.resize(movingBlocks);
+	std::partial_sum(componentStart_.begin(), componentStart_.end(), componentStart_.begin());
+	const int coupledBlocks = componentStart_.back();
+	members_.resize(coupledBlocks);
+	unknowns_.resize(coupledBlocks);
+	std::vector<int> next(componentStart_.begin(), componentStart_.end() - 1);
+	for (int k = 0; k < movingBlocks; ++k) {
+		if (slot_[k] < 0) continue;
+		const int s = next[slot_[k]]++;
+		slot_[k] = s;
+		members_[s] = k;
+		unknowns_[s] = unknowns[k];
+	}
+	// A pair joined by several contacts is one link.
+	linkSlots_.clear();
+	for (auto [a, b] : links) {
+		if (a == b) continue;
+		linkSlots_.emplace_back(std::min(slot_[a], slot_[b]), std::max(slot_[a], slot_[b]));
+	}
+	std::sort(linkSlots_.begin(), linkSlots_.end());
+	linkSlots_.erase(std::unique(linkSlots_.begin(), linkSlots_.end()), linkSlots_.end());
+	// Both slots of a link lie in one component, whose slots are contiguous.
+	linkStart_.resize(componentStart_.size());
+	std::size_t link = 0;
+	for (std::size_t c = 0; c < componentStart_.size(); ++c) {
+		while (link < linkSlots_.size() && linkSlots_[link].first < componentStart_[c]) ++link;
+		linkStart_[c] = static_cast<int>(link);
+	}
+	offDiagonal_.resize(linkSlots_.size());
+	diagonal_.resize(coupledBlocks);
+	force_.resize(coupledBlocks);
 }
 
-void CoupledSystem::reset(const std::vector<BlockSystem>& blockSystems) {
-	for (std::size_t k = 0; k < diagonal_.size(); ++k) {
-		diagonal_[k] = blockSystems[k].stiffness;
-		force_[k] = blockSystems[k].force;
+void CoupledSystem::reset(const std::vector<BlockSystem>& systems, const std::vector<int>& systemOf) {
+	for (std::size_t s = 0; s < members_.size(); ++s) {
+		const BlockSystem& own = systems[systemOf[members_[s]]];
+		diagonal_[s] = own.stiffness;
+		force_[s] = own.force;
 	}
 	for (Matrix12& m : offDiagonal_) m.setZero();
 }
 
 Matrix12& CoupledSystem::offDiagonal(int a, int b, bool& transposed) {
-	transposed = a > b;
-	return offDiagonal_[offDiagonalIndex_.at(linkKey(std::min(a, b), std::max(a, b)))];
+	const int sa = slot_[a], sb = slot_[b];
+	// Within a component slots ascend with the moving-block index, so this is a > b.
+	transposed = sa > sb;
+	const std::pair<int, int> key(std::min(sa, sb), std::max(sa, sb));
+	const auto link = std::lower_bound(linkSlots_.begin(), linkSlots_.end(), key);
+	if (link == linkSlots_.end() || *link != key)
+		throw std::out_of_range("no link between moving blocks " + std::to_string(a) + " and " + std::to_string(b));
+	return offDiagonal_[link - linkSlots_.begin()];
 }
 
 int CoupledSystem::largestComponent() const {
-	std::size_t largest = 0;
-	for (const auto& c : components_) largest = std::max(largest, c.size());
-	return static_cast<int>(largest);
+	int largest = 0;
+	for (int c = 0; c < components(); ++c) largest = std::max(largest, componentStart_[c + 1] - componentStart_[c]);
+	return largest;
 }
 
-void CoupledSystem::solve(const std::vector<const Block*>& blocks, std::vector<Vector12>& solutions, int threadsFrom) {
+std::size_t CoupledSystem::memoryBytes() const {
+	const auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+	return bytes(slot_) + bytes(members_) + bytes(unknowns_) + bytes(componentStart_) + bytes(diagonal_) +
+	       bytes(force_) + bytes(linkSlots_) + bytes(linkStart_) + bytes(offDiagonal_);
+}
+
+void CoupledSystem::solve(std::vector<Vector12>& solutions, int threadsFrom) {
 	const int count = components();
 	bool failed = false;
-#pragma omp parallel for schedule(dynamic) if (count >= threadsFrom)
+	// An integer sum, exact in any order: the count does not depend on the thread count.
+	long solved = 0;
+#pragma omp parallel for schedule(dynamic) reduction(+ : solved) if (count >= threadsFrom)
 	for (int c = 0; c < count; ++c) {
-		const std::vector<int>& members = components_[c];
-		if (members.size() == 1) {
-			const int k = members[0];
-			componentUnknowns_[c] = unknowns_[k];
-			if (!hasSprings_[k]) {
-				solutions[k] = solveBlock(*blocks[k], BlockSystem{diagonal_[k], force_[k]});
-			} else if (unknowns_[k] == kRigidBlockDofs) {
-				Eigen::LLT<Matrix6> llt(diagonal_[k].topLeftCorner<kRigidBlockDofs, kRigidBlockDofs>());
+		const int first = componentStart_[c], last = componentStart_[c + 1];
+		if (last - first == 1) {
+			const int k = members_[first];
+			solved += unknowns_[first];
+			if (unknowns_[first] == kRigidBlockDofs) {
+				Eigen::LLT<Matrix6> llt(diagonal_[first].topLeftCorner<kRigidBlockDofs, kRigidBlockDofs>());
 				if (llt.info() != Eigen::Success) {
 #pragma omp atomic write
 					failed = true;
 				}
-				solutions[k].head<kRigidBlockDofs>() = llt.solve(force_[k].head<kRigidBlockDofs>());
+				solutions[k].head<kRigidBlockDofs>() = llt.solve(force_[first].head<kRigidBlockDofs>());
 				solutions[k].tail<kBlockDofs - kRigidBlockDofs>().setZero();
 			} else {
-				Eigen::LLT<Matrix12> llt(diagonal_[k]);
+				Eigen::LLT<Matrix12> llt(diagonal_[first]);
 				if (llt.info() != Eigen::Success) {
 #pragma omp atomic write
 					failed = true;
 				}
-				solutions[k] = llt.solve(force_[k]);
+				solutions[k] = llt.solve(force_[first]);
 			}
 			continue;
 		}
-		// Variable block sizes: member l's unknowns start at offset[l] and
-		// number unknowns_[k] (12, or 6 for a rigid block, whose strain rows
-		// and columns of the stored 12x12 blocks are left out).
-		std::vector<int> offset(members.size() + 1, 0);
-		for (std::size_t l = 0; l < members.size(); ++l) offset[l + 1] = offset[l] + unknowns_[members[l]];
+		// Variable block sizes: slot s's unknowns start at offset[s - first]
+		// and number unknowns_[s] (12, or 6 for a rigid block, whose strain
+		// rows and columns of the stored 12x12 blocks are left out).
+		std::vector<int> offset(last - first + 1, 0);
+		for (int s = first; s < last; ++s) offset[s - first + 1] = offset[s - first] + unknowns_[s];
 		const int n = offset.back();
-		componentUnknowns_[c] = n;
+		solved += n;
 		std::vector<Eigen::Triplet<double>> entries;
-		entries.reserve(members.size() * 78 + componentLinks_[c].size() * 144);
+		entries.reserve(static_cast<std::size_t>(last - first) * 78 +
+		                static_cast<std::size_t>(linkStart_[c + 1] - linkStart_[c]) * 144);
 		Eigen::VectorXd rhs(n);
-		for (std::size_t l = 0; l < members.size(); ++l) {
-			const int k = members[l];
-			const int base = offset[l], size = unknowns_[k];
+		for (int s = first; s < last; ++s) {
+			const int base = offset[s - first], size = unknowns_[s];
 			for (int col = 0; col < size; ++col)
-				for (int row = col; row < size; ++row) entries.emplace_back(base + row, base + col, diagonal_[k](row, col));
-			rhs.segment(base, size) = force_[k].head(size);
+				for (int row = col; row < size; ++row) entries.emplace_back(base + row, base + col, diagonal_[s](row, col));
+			rhs.segment(base, size) = force_[s].head(size);
 		}
-		for (int slot : componentLinks_[c]) {
+		for (int link = linkStart_[c]; link < linkStart_[c + 1]; ++link) {
 			// Stored block is K[lo][hi]; the lower triangle holds K[hi][lo] = its transpose.
-			const auto [lo, hi] = offDiagonalPairs_[slot];
-			const int rowBase = offset[localIndex_[hi]], colBase = offset[localIndex_[lo]];
+			const auto [lo, hi] = linkSlots_[link];
+			const int rowBase = offset[hi - first], colBase = offset[lo - first];
 			const int rows = unknowns_[hi], cols = unknowns_[lo];
-			const Matrix12& m = offDiagonal_[slot];
+			const Matrix12& m = offDiagonal_[link];
 			for (int col = 0; col < cols; ++col)
 				for (int row = 0; row < rows; ++row) entries.emplace_back(rowBase + row, colBase + col, m(col, row));
 		}
@@ -149,17 +179,14 @@ void CoupledSystem::solve(const std::vector<const Block*>& blocks, std::vector<V
 			continue;
 		}
 		const Eigen::VectorXd x = llt.solve(rhs);
-		for (std::size_t l = 0; l < members.size(); ++l) {
-			const int k = members[l], size = unknowns_[k];
+		for (int s = first; s < last; ++s) {
+			const int k = members_[s], size = unknowns_[s];
 			solutions[k].setZero();
-			solutions[k].head(size) = x.segment(offset[l], size);
+			solutions[k].head(size) = x.segment(offset[s - first], size);
 		}
 	}
 	if (failed) throw std::runtime_error("the DDA system is not positive definite (Cholesky failed)");
-	// Summed in component order after the loop, so the count does not depend
-	// on the thread count.
-	solvedUnknowns_ = 0;
-	for (int c = 0; c < count; ++c) solvedUnknowns_ += componentUnknowns_[c];
+	solvedUnknowns_ = solved;
 }
 
 }  // namespace dda

@@ -1,34 +1,36 @@
-// The global DDA system K D = F of the moving blocks, block-sparse: a 12x12
-// diagonal block per moving block, and an off-diagonal block per pair of
-// moving blocks joined by at least one closed contact (open contacts carry no
-// terms; World rebuilds the structure when the open-close iteration opens or
-// closes one). Blocks that no closed contact joins form independent
-// components, each solved on its own:
-//   - one block without contacts or fixed points: the block's own 3 + 9 solve
-//     (BlockEquations.hpp), so a free block is not affected by the rest of
-//     the scene, not even by round-off;
+// The global DDA system K D = F of the moving blocks that have springs (closed
+// contacts or fixed points), block-sparse: a 12x12 diagonal block per such
+// block, and an off-diagonal block per pair of moving blocks joined by at
+// least one closed contact (open contacts carry no terms; World rebuilds the
+// structure when the open-close iteration opens or closes one). Blocks that no
+// closed contact joins form independent components, each solved on its own:
 //   - one block with closed contacts (against fixed blocks) or fixed points: a dense
 //     12x12 Cholesky;
 //   - several blocks: a sparse Cholesky (Eigen's SimplicialLLT, AMD order).
+// A block without springs is not part of it: World solves it by the block's
+// own 3 + 9 solve (BlockEquations.hpp), so a free block is not affected by the
+// rest of the scene, not even by round-off, and costs no stored 12x12 block.
 // K is symmetric positive definite: the mass term is, and springs add
 // positive semi-definite terms.
 //
+// Storage is by slot: the blocks with springs numbered component by
+// component, ascending within one, so a component's diagonal blocks and its
+// links (sorted by slot pair) are contiguous ranges.
+//
 // Rigid blocks have 6 unknowns, not 12. Every block keeps the 12-layout in
 // storage (contact terms are assembled as for any block), but a rigid block's
-// strain rows and columns never enter a factorisation: its own solve is 3 + 3
-// or 6x6, and in a sparse component the unknowns are numbered with variable
-// block sizes (offsets), the strain rows and columns of its stored blocks
-// skipped. Leaving them out is exactly the constraint strain = 0 (the
-// restriction of the quadratic energy to the rigid subspace); its solution's
-// strain part is set to zero.
+// strain rows and columns never enter a factorisation: alone in its
+// component it is solved 6x6 (3 + 3 without springs, by World), and in a
+// sparse component the unknowns are numbered with variable block sizes
+// (offsets), the strain rows and columns of its stored blocks skipped.
+// Leaving them out is exactly the constraint strain = 0 (the restriction of
+// the quadratic energy to the rigid subspace); its solution's strain part is
+// set to zero.
 #pragma once
 
 #include "BlockEquations.hpp"
 
-#include <Eigen/Sparse>
-
-#include <cstdint>
-#include <unordered_map>
+#include <cstddef>
 #include <utility>
 #include <vector>
 
@@ -38,43 +40,51 @@ class CoupledSystem {
 public:
 	// Sets the structure: `links` lists pairs of moving-block indices
 	// (0 .. movingBlocks-1) joined by a closed contact; `hasSprings[k]` says
-	// whether block k has closed contacts or fixed points (so needs the 12x12
-	// solve); `unknowns[k]` is its number of unknowns (kBlockDofs, or
-	// kRigidBlockDofs for a rigid block).
+	// whether block k has closed contacts or fixed points (so belongs to the
+	// system; both blocks of a link must have it); `unknowns[k]` is its number
+	// of unknowns (kBlockDofs, or kRigidBlockDofs for a rigid block).
 	void build(int movingBlocks, const std::vector<std::pair<int, int>>& links, const std::vector<char>& hasSprings,
 	           const std::vector<int>& unknowns);
+	// Whether moving block k belongs to the system (had springs at the last build).
+	bool coupled(int k) const { return slot_[k] >= 0; }
+	// Blocks that belong to the system.
+	int blocks() const { return static_cast<int>(members_.size()); }
 
-	// Starts an assembly from the blocks' own systems.
-	void reset(const std::vector<BlockSystem>& blockSystems);
-	Matrix12& diagonal(int k) { return diagonal_[k]; }
-	Vector12& force(int k) { return force_[k]; }
+	// Starts an assembly: each coupled block k from its own system,
+	// systems[systemOf[k]].
+	void reset(const std::vector<BlockSystem>& systems, const std::vector<int>& systemOf);
+	// Coupled block k's diagonal block and force.
+	Matrix12& diagonal(int k) { return diagonal_[slot_[k]]; }
+	Vector12& force(int k) { return force_[slot_[k]]; }
 	// The off-diagonal block of row a, column b (a, b joined by build's links);
 	// the (b, a) block is its transpose and is not stored.
 	Matrix12& offDiagonal(int a, int b, bool& transposed);
 
-	// Solves every component; solutions[k] for moving block k. `blocks[k]`
-	// is moving block k (for the 3 + 9 fast path). Throws std::runtime_error if
-	// a factorisation fails (K not positive definite).
-	void solve(const std::vector<const Block*>& blocks, std::vector<Vector12>& solutions, int threadsFrom);
+	// Solves every component; solutions[k] for each coupled moving block k
+	// (the others are left as they are). Throws std::runtime_error if a
+	// factorisation fails (K not positive definite).
+	void solve(std::vector<Vector12>& solutions, int threadsFrom);
 
-	int components() const { return static_cast<int>(components_.size()); }
+	int components() const { return static_cast<int>(componentStart_.size()) - 1; }
 	int largestComponent() const;
 	// Unknowns factorised by the last solve, all components together.
 	long solvedUnknowns() const { return solvedUnknowns_; }
+	// Heap held [bytes] (the arrays' capacities).
+	std::size_t memoryBytes() const;
 
 private:
-	std::vector<std::vector<int>> components_;  // moving-block indices, ascending
-	std::vector<int> componentOf_, localIndex_;
-	std::vector<char> hasSprings_;
-	std::vector<int> unknowns_;           // per moving block: 12, or 6 when rigid
-	std::vector<long> componentUnknowns_;  // per component, of the last solve
+	std::vector<int> slot_;            // per moving block: its slot, -1 when it has no springs
+	std::vector<int> members_;         // per slot: the moving block
+	std::vector<int> unknowns_;        // per slot: 12, or 6 when rigid
+	std::vector<int> componentStart_;  // component c holds slots componentStart_[c] .. componentStart_[c+1]-1
+	std::vector<Matrix12> diagonal_;   // per slot
+	std::vector<Vector12> force_;      // per slot
+	// Per link, the slots (lo, hi), lo < hi, sorted; its stored block is
+	// K[lo][hi]. Component c's links are linkStart_[c] .. linkStart_[c+1]-1.
+	std::vector<std::pair<int, int>> linkSlots_;
+	std::vector<int> linkStart_;
+	std::vector<Matrix12> offDiagonal_;  // per link
 	long solvedUnknowns_ = 0;
-	std::vector<Matrix12> diagonal_;
-	std::vector<Vector12> force_;
-	std::vector<Matrix12> offDiagonal_;
-	std::unordered_map<std::uint64_t, int> offDiagonalIndex_;  // (min, max) -> slot
-	std::vector<std::pair<int, int>> offDiagonalPairs_;          // slot -> (min, max)
-	std::vector<std::vector<int>> componentLinks_;               // slots per component
 };
 
 }  // namespace dda

@@ -304,10 +304,15 @@ void World::setCollider(std::unique_ptr<Collider> collider) {
 	collider_ = std::move(collider);
 }
 
-const Vector12& World::ofBlock(const std::vector<Vector12>& perMovingBlock, int block) const {
+const Vector12& World::solutionOf(int block) const {
 	static const Vector12 zero = Vector12::Zero();
 	const int k = movingIndex_[block];
-	return k < 0 ? zero : perMovingBlock[k];
+	return k < 0 ? zero : solutions_[k];
+}
+
+Vector12 World::startVelocityOf(int block, const IntegratorSettings& settings) const {
+	if (movingIndex_[block] < 0) return Vector12::Zero();
+	return startVelocity(blocks_[block], settings);
 }
 
 void World::detectContacts(const IntegratorSettings& settings, StepStatistics& stats) {
@@ -411,6 +416,10 @@ World::MemoryUse World::memoryUse() const {
 	for (const auto& result : pairResults_)
 		if (result) use.narrowPhase += capacityBytes(result->contacts);
 	for (const BlockPlanes& planes : planes_) use.narrowPhase += capacityBytes(planes.faces) + capacityBytes(planes.edges);
+	use.solver = coupled_.memoryBytes() + capacityBytes(moving_) + capacityBytes(movingIndex_) +
+	             capacityBytes(solutions_) + capacityBytes(motions_) + capacityBytes(ownSystems_) +
+	             capacityBytes(ownSystemOf_) + capacityBytes(solvedAlone_) + capacityBytes(links_) +
+	             capacityBytes(hasSprings_) + capacityBytes(blockUnknowns_);
 	return use;
 }
 
@@ -426,9 +435,48 @@ void World::buildSystemStructure(int movingBlocks, StepStatistics& stats) {
 		if (mi >= 0 && mj >= 0) links_.emplace_back(mi, mj);
 	}
 	coupled_.build(movingBlocks, links_, hasSprings_, blockUnknowns_);
+	aloneUnknowns_ = 0;
+	for (int k = 0; k < movingBlocks; ++k)
+		if (!hasSprings_[k]) aloneUnknowns_ += blockUnknowns_[k];
 	++stats.systemStructures;
-	stats.components = coupled_.components();
-	stats.largestComponent = coupled_.largestComponent();
+	// A block left alone is a component of its own.
+	const int alone = movingBlocks - coupled_.blocks();
+	stats.components = coupled_.components() + alone;
+	stats.largestComponent = std::max(coupled_.largestComponent(), alone > 0 ? 1 : 0);
+}
+
+void World::assembleOwnSystems(const IntegratorSettings& settings, double dt) {
+	const int n = static_cast<int>(moving_.size());
+	const int kept = static_cast<int>(ownSystems_.size());
+	int count = kept;
+	for (int k = 0; k < n; ++k)
+		if (coupled_.coupled(k) && ownSystemOf_[k] < 0) ownSystemOf_[k] = count++;
+	ownSystems_.resize(count);
+#pragma omp parallel for schedule(static) if (count - kept >= kMinBlocksForThreads)
+	for (int k = 0; k < n; ++k)
+		if (ownSystemOf_[k] >= kept) assembleBlock(blocks_[moving_[k]], settings, dt, ownSystems_[ownSystemOf_[k]]);
+}
+
+void World::solveAloneBlocks(const IntegratorSettings& settings, double dt) {
+	const int n = static_cast<int>(moving_.size());
+	int unsolved = 0;
+	for (int k = 0; k < n; ++k) {
+		if (coupled_.coupled(k))
+			solvedAlone_[k] = 0;  // coupled_.solve writes its solution
+		else
+			unsolved += !solvedAlone_[k];
+	}
+	// Threads only for work: each parallel region can wait a scheduler slice
+	// on a loaded machine (kMinBlocksForThreads).
+#pragma omp parallel for schedule(static) if (unsolved >= kMinBlocksForThreads)
+	for (int k = 0; k < n; ++k) {
+		if (coupled_.coupled(k) || solvedAlone_[k]) continue;
+		const Block& block = blocks_[moving_[k]];
+		BlockSystem system;
+		assembleBlock(block, settings, dt, system);
+		solutions_[k] = solveBlock(block, system);
+		solvedAlone_[k] = 1;
+	}
 }
 
 void World::assembleContacts(StepStatistics& stats) {
@@ -482,14 +530,7 @@ double World::step(const IntegratorSettings& settings) {
 		stats.rigidBlocks += b.rigid;
 		stats.strainUnknowns += b.unknowns() - kRigidBlockDofs;
 	}
-	systems_.resize(n);
 	solutions_.resize(n);
-	startVelocities_.resize(n);
-	movingBlocks_.resize(n);
-	for (int k = 0; k < n; ++k) {
-		startVelocities_[k] = startVelocity(blocks_[moving_[k]], settings);
-		movingBlocks_[k] = &blocks_[moving_[k]];
-	}
 
 	stats.allowedDisplacement = settings.maxDisplacement > 0 ? settings.maxDisplacement
 	                                                         : settings.maxDisplacementRatio * sceneHalfSize();
@@ -503,10 +544,10 @@ double World::step(const IntegratorSettings& settings) {
 	double dt = nextTimeStep_ > 0 ? std::min(nextTimeStep_, settings.maxTimeStep) : settings.maxTimeStep;
 
 	for (int attempt = 0;; ++attempt) {
-		auto phase = Clock::now();
-#pragma omp parallel for schedule(static) if (n >= kMinBlocksForThreads)
-		for (int k = 0; k < n; ++k) assembleBlock(blocks_[moving_[k]], settings, dt, systems_[k]);
-		stats.timeAssembly += secondsSince(phase);
+		// The blocks' own systems depend on dt: assembled anew in each attempt.
+		ownSystems_.clear();
+		ownSystemOf_.assign(n, -1);
+		solvedAlone_.assign(n, 0);
 		// assembleBlock adds a body force only for non-zero gravity.
 		if (!settings.gravity.isZero()) stats.bodyForceBlocks += n;
 
@@ -517,20 +558,26 @@ double World::step(const IntegratorSettings& settings) {
 			contact.frictionSwitches = 0;
 			contact.openCloseSwitches = 0;
 			const int bi = contact.key.blockI, bj = contact.key.blockJ;
-			startSlidingIfMoving(contact, blocks_[bi], blocks_[bj], ofBlock(startVelocities_, bi), ofBlock(startVelocities_, bj), dt);
+			startSlidingIfMoving(contact, blocks_[bi], blocks_[bj], startVelocityOf(bi, settings), startVelocityOf(bj, settings), dt);
 		}
 		bool converged = false, structureStale = true;
 		int iterations = 0, changes = 0;
 		while (iterations < std::max(1, settings.maxOpenCloseIterations)) {
-			phase = Clock::now();
-			if (structureStale) buildSystemStructure(n, stats);
+			auto phase = Clock::now();
+			const bool rebuilt = structureStale;
+			if (structureStale) {
+				buildSystemStructure(n, stats);
+				assembleOwnSystems(settings, dt);
+			}
 			structureStale = false;
-			coupled_.reset(systems_);
+			coupled_.reset(ownSystems_, ownSystemOf_);
 			assembleContacts(stats);
 			stats.timeAssembly += secondsSince(phase);
 			phase = Clock::now();
-			coupled_.solve(movingBlocks_, solutions_, kMinBlocksForThreads);
-			stats.solvedUnknowns = coupled_.solvedUnknowns();
+			// Which blocks are alone changes only with the structure.
+			if (rebuilt) solveAloneBlocks(settings, dt);
+			coupled_.solve(solutions_, kMinBlocksForThreads);
+			stats.solvedUnknowns = coupled_.solvedUnknowns() + aloneUnknowns_;
 			stats.timeSolve += secondsSince(phase);
 			++iterations;
 			changes = 0;
@@ -540,7 +587,7 @@ double World::step(const IntegratorSettings& settings) {
 				const ContactHistory before = contact.trial;
 				if (contact.trial.state != ContactState::Open)
 					largestNormalForce = std::max(largestNormalForce, std::abs(contact.trial.normalForce));
-				if (!updateContactState(contact, blocks_[bi], blocks_[bj], ofBlock(solutions_, bi), ofBlock(solutions_, bj), openTolerance)) {
+				if (!updateContactState(contact, blocks_[bi], blocks_[bj], solutionOf(bi), solutionOf(bj), openTolerance)) {
 					if (contact.trial.state == ContactState::Sliding && contact.frictionTangent > 0)
 						normalForceChange = std::max(normalForceChange,
 						                             std::abs(contact.trial.normalForce - before.normalForce));
@@ -564,7 +611,7 @@ double World::step(const IntegratorSettings& settings) {
 					// often cycled again at the smaller dt.
 					if (contact.trial.state == ContactState::Open && !before.bonded &&
 					    contact.openCloseSwitches >= kOpenCloseSwitchesCounted &&
-					    contactGap(contact, ofBlock(solutions_, bi), ofBlock(solutions_, bj)) <= holdClosedGap) {
+					    contactGap(contact, solutionOf(bi), solutionOf(bj)) <= holdClosedGap) {
 						contact.trial = before;
 						++stats.openCloseHeld;
 						continue;
@@ -654,7 +701,7 @@ double World::step(const IntegratorSettings& settings) {
 	for (int k = 0; k < n; ++k) motions_[k] = blockMotion(blocks_[moving_[k]], solutions_[k]);
 	for (Contact& contact : contacts) {
 		const int bi = contact.key.blockI, bj = contact.key.blockJ;
-		finishContact(contact, blocks_[bi], blocks_[bj], ofBlock(solutions_, bi), ofBlock(solutions_, bj));
+		finishContact(contact, blocks_[bi], blocks_[bj], solutionOf(bi), solutionOf(bj));
 		ContactHistory& trial = contact.trial;
 		contact.point = movingIndex_[bi] >= 0 ? motions_[movingIndex_[bi]](contact.geometry.pointI) : contact.geometry.pointI;
 		if (trial.state == ContactState::Locked) {
@@ -665,13 +712,16 @@ double World::step(const IntegratorSettings& settings) {
 			++stats.closedContacts;
 			stats.slidingContacts += trial.state == ContactState::Sliding;
 			stats.maxPenetration =
-			    std::max(stats.maxPenetration, -contactGap(contact, ofBlock(solutions_, bi), ofBlock(solutions_, bj)));
+			    std::max(stats.maxPenetration, -contactGap(contact, solutionOf(bi), solutionOf(bj)));
 		}
 		contact.history = trial;
 		stats.bondedContacts += trial.bonded;
 	}
 #pragma omp parallel for schedule(static) if (n >= kMinBlocksForThreads)
-	for (int k = 0; k < n; ++k) applyStep(blocks_[moving_[k]], solutions_[k], startVelocities_[k], dt);
+	for (int k = 0; k < n; ++k) {
+		Block& block = blocks_[moving_[k]];
+		applyStep(block, solutions_[k], startVelocity(block, settings), dt);
+	}
 	stats.timeUpdate = secondsSince(phase);
 
 	nextTimeStep_ = std::min(settings.maxTimeStep, dt * settings.timeStepGrowth);

@@ -56,9 +56,12 @@ public:
 	// phase's arrays (Collider::memoryBytes), the contact store (with the last
 	// step's contacts kept for their history), and the narrow phase's work
 	// arrays (per-block planes, per-pair results). Between steps they are
-	// what the last detection left.
+	// what the last detection left. The solver's: the per-step arrays of the
+	// moving blocks (solutions, motions, the own systems of the blocks with
+	// springs) and the coupled system (CoupledSystem::memoryBytes), as the
+	// last step left them.
 	struct MemoryUse {
-		std::size_t collider = 0, contacts = 0, narrowPhase = 0;
+		std::size_t collider = 0, contacts = 0, narrowPhase = 0, solver = 0;
 	};
 	MemoryUse memoryUse() const;
 	double time() const { return time_; }
@@ -88,11 +91,22 @@ private:
 	// closed contacts carry terms, so only they join blocks into components
 	// (an open contact within d0 couples nothing until it closes).
 	void buildSystemStructure(int movingBlocks, StepStatistics& stats);
+	// The own system (assembleBlock) of each block that the last structure
+	// build coupled and that has none yet in this attempt: it is the same at
+	// every iteration, so it is kept (ownSystems_) for coupled_.reset.
+	void assembleOwnSystems(const IntegratorSettings& settings, double dt);
+	// Each moving block that the last build left out of coupled_ (no springs)
+	// and that has no solution yet in this attempt, by its own 3 + 9 solve
+	// (solveBlock). Its system is the same at every iteration, so it is solved
+	// once per attempt, and assembled here on the stack rather than kept (its
+	// assembly counts as solve time).
+	void solveAloneBlocks(const IntegratorSettings& settings, double dt);
 	// Adds the trial-state terms of every contact to coupled_ (counted in stats).
 	void assembleContacts(StepStatistics& stats);
-	// A block's entry of a per-moving-block array (solutions_, startVelocities_);
-	// zero for fixed blocks.
-	const Vector12& ofBlock(const std::vector<Vector12>& perMovingBlock, int block) const;
+	// A block's entry of solutions_; zero for fixed blocks.
+	const Vector12& solutionOf(int block) const;
+	// A block's start-of-step velocity (startVelocity); zero for fixed blocks.
+	Vector12 startVelocityOf(int block, const IntegratorSettings& settings) const;
 	std::unique_ptr<Collider> collider_ = std::make_unique<DESSCollider>();
 	ContactStore store_;
 	CoupledSystem coupled_;
@@ -101,7 +115,6 @@ private:
 	std::vector<std::optional<PairContacts>> pairResults_;
 	std::vector<NarrowPhaseWork> pairWork_;  // per candidate pair
 	std::vector<int> movingIndex_;  // block -> index in moving_, -1 for fixed blocks
-	std::vector<const Block*> movingBlocks_;
 	std::vector<BlockMotion> motions_;
 	std::vector<double> diagonals_;  // per block, bounding-box diagonal of this step [m]
 	// Per block, its face planes, edge data and bounding box for this step's
@@ -117,6 +130,7 @@ private:
 	std::vector<std::pair<int, int>> links_;  // buildSystemStructure's work arrays
 	std::vector<char> hasSprings_;
 	std::vector<int> blockUnknowns_;  // per moving block: 12, or 6 when rigid
+	long aloneUnknowns_ = 0;          // of the moving blocks left out of coupled_
 	std::vector<Block> blocks_;
 	StepStatistics stats_;
 	double nextTimeStep_ = 0;  // dt to try first in the next step; 0 = maxTimeStep
@@ -127,8 +141,13 @@ private:
 	int sceneSizedBlocks_ = -1;  // block count when sceneHalfSize_ was measured
 	// per-step work arrays, kept to avoid reallocation
 	std::vector<int> moving_;
-	std::vector<BlockSystem> systems_;
-	std::vector<Vector12> solutions_, startVelocities_;
+	std::vector<Vector12> solutions_;
+	// This attempt's own systems of the blocks coupled at some build
+	// (ownSystemOf_: per moving block, its index there, -1 if none), and which
+	// blocks left alone already have their solution.
+	std::vector<BlockSystem> ownSystems_;
+	std::vector<int> ownSystemOf_;
+	std::vector<char> solvedAlone_;
 };
 
 }  // namespace dda
