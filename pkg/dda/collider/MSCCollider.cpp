@@ -74,6 +74,14 @@ void resizeWithHeadroom(std::vector<T>& v, std::size_t n) {
 	v.resize(n);
 }
 
+// Appends x, the capacity growing by 1/8 when full (not doubling: the arrays
+// so filled are kept from call to call at their largest size).
+template <class T>
+void pushWithHeadroom(std::vector<T>& v, const T& x) {
+	if (v.size() == v.capacity()) v.reserve(v.size() + v.size() / 8 + 64);
+	v.push_back(x);
+}
+
 std::uint64_t hashList(const std::vector<int>& list) {
 	std::uint64_t h = list.size();
 	for (int i : list) {
@@ -304,7 +312,7 @@ int MSCCollider::linkedSet(int block, std::uint64_t shells) {
 		set.lists[kind] = internList(listScratch_);
 	}
 	cover.linkedSets = static_cast<int>(linkedSets_.size());
-	linkedSets_.push_back(set);
+	pushWithHeadroom(linkedSets_, set);
 	if (static_cast<std::size_t>(++cover.linkedSetCount) > kMaxLinkedSetsPerBlock) linkedSetsOverflow_ = true;
 	return cover.linkedSets;
 }
@@ -367,18 +375,19 @@ long MSCCollider::gridSearch(const std::vector<Block>& blocks, const std::vector
 	};
 	const Eigen::Array<long, 3, 1> dims = cellOf(domain.max()).cast<long>() + 1;
 	resizeWithHeadroom(cellLow_, shellTotal);
-	resizeWithHeadroom(cellHigh_, shellTotal);
+	resizeWithHeadroom(cellSpan_, shellTotal);
 	oversize_.clear();
-	isOversize_.assign(shellTotal, 0);
 	std::size_t entries = 0;
 	for (int s = 0; s < shellTotal; ++s) {
 		cellLow_[s] = cellOf(boxes[s].min());
-		cellHigh_[s] = cellOf(boxes[s].max());
-		const long span = (cellHigh_[s] - cellLow_[s] + 1).cast<long>().prod();
+		const Cell extra = cellOf(boxes[s].max()) - cellLow_[s];
+		const long span = (extra + 1).cast<long>().prod();
 		if (span > kMaxCellsPerShell) {
 			oversize_.push_back(s);
-			isOversize_[s] = 1;
+			cellSpan_[s] = CellSpan{0, 0, 0, true};
 		} else {
+			cellSpan_[s] = CellSpan{static_cast<std::uint8_t>(extra.x()), static_cast<std::uint8_t>(extra.y()),
+			                        static_cast<std::uint8_t>(extra.z()), false};
 			entries += static_cast<std::size_t>(span);
 		}
 	}
@@ -411,7 +420,7 @@ long MSCCollider::gridSearch(const std::vector<Block>& blocks, const std::vector
 		const bool meet = (lowS.x() <= highT.x()) & (lowT.x() <= highS.x()) & (lowS.y() <= highT.y()) &
 		                  (lowT.y() <= highS.y()) & (lowS.z() <= highT.z()) & (lowT.z() <= highS.z());
 		tests += mine & pair;
-		if (mine & pair & meet) out.push_back(a < b ? ShellPair{s, t} : ShellPair{t, s});
+		if (mine & pair & meet) pushWithHeadroom(out, a < b ? ShellPair{s, t} : ShellPair{t, s});
 	};
 	// The shells of cell `here`: cellShells_[first, last), ascending; a pair
 	// is compared in the cell of the max of its lowest cells only.
@@ -424,7 +433,7 @@ long MSCCollider::gridSearch(const std::vector<Block>& blocks, const std::vector
 	};
 	const auto forEachCellOf = [&](int s, const auto& visit) {
 		const Cell& lo = cellLow_[s];
-		const Cell& hi = cellHigh_[s];
+		const Cell hi = lo + Cell(cellSpan_[s].x, cellSpan_[s].y, cellSpan_[s].z);
 		for (int i = lo.x(); i <= hi.x(); ++i)
 			for (int j = lo.y(); j <= hi.y(); ++j)
 				for (int k = lo.z(); k <= hi.z(); ++k) visit(key(Cell(i, j, k)));
@@ -438,10 +447,10 @@ long MSCCollider::gridSearch(const std::vector<Block>& blocks, const std::vector
 		resizeWithHeadroom(cellStart_, cells + 2);
 		std::fill(cellStart_.begin(), cellStart_.end(), 0);
 		for (int s = 0; s < shellTotal; ++s)
-			if (!isOversize_[s]) forEachCellOf(s, [&](std::uint64_t c) { ++cellStart_[c + 1]; });
+			if (!cellSpan_[s].oversize) forEachCellOf(s, [&](std::uint64_t c) { ++cellStart_[c + 1]; });
 		for (std::size_t c = 0; c < cells; ++c) cellStart_[c + 1] += cellStart_[c];
 		for (int s = shellTotal - 1; s >= 0; --s)
-			if (!isOversize_[s]) forEachCellOf(s, [&](std::uint64_t c) { cellShells_[--cellStart_[c + 1]] = s; });
+			if (!cellSpan_[s].oversize) forEachCellOf(s, [&](std::uint64_t c) { cellShells_[--cellStart_[c + 1]] = s; });
 		// Now cellStart_[c + 1] is the start of cell c; cell c is [cellStart_[c + 1], cellStart_[c + 2]).
 		cellStart_[cells + 1] = static_cast<std::uint32_t>(entries);
 		for (std::size_t c = 0; c < cells; ++c)
@@ -450,7 +459,7 @@ long MSCCollider::gridSearch(const std::vector<Block>& blocks, const std::vector
 		cellEntries_.clear();
 		cellEntries_.reserve(entries);
 		for (int s = 0; s < shellTotal; ++s)
-			if (!isOversize_[s]) forEachCellOf(s, [&](std::uint64_t c) { cellEntries_.emplace_back(c, s); });
+			if (!cellSpan_[s].oversize) forEachCellOf(s, [&](std::uint64_t c) { cellEntries_.emplace_back(c, s); });
 		std::sort(cellEntries_.begin(), cellEntries_.end());
 		for (std::size_t p = 0; p < entries; ++p) cellShells_[p] = cellEntries_[p].second;
 		for (std::size_t first = 0; first < entries;) {
@@ -462,7 +471,7 @@ long MSCCollider::gridSearch(const std::vector<Block>& blocks, const std::vector
 	}
 	for (int s : oversize_)
 		for (int t = 0; t < shellTotal; ++t)
-			if (t != s && (!isOversize_[t] || s < t)) compare(s, t, true);
+			if (t != s && (!cellSpan_[t].oversize || s < t)) compare(s, t, true);
 	return tests;
 }
 
@@ -629,7 +638,7 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 				}
 				kept_.clear();
 				for (const ShellPair& p : cached_)
-					if (!moved_[shellBlock_[p.s]] && !moved_[shellBlock_[p.t]]) kept_.push_back(p);
+					if (!moved_[shellBlock_[p.s]] && !moved_[shellBlock_[p.t]]) pushWithHeadroom(kept_, p);
 				stats.pairsReused = static_cast<long>(kept_.size());
 				for (int m : movers_) {
 					const BlockCover& cover = covers_[m];
@@ -639,7 +648,7 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 							if (b == m || (moved_[b] && b < m) || (blocks[b].fixed && blocks[m].fixed)) continue;
 							++stats.shellTests;
 							if (searchBoxes_[s].intersects(searchBoxes_[t]))
-								kept_.push_back(m < b ? ShellPair{s, t} : ShellPair{t, s});
+								pushWithHeadroom(kept_, m < b ? ShellPair{s, t} : ShellPair{t, s});
 						}
 				}
 				sortShellPairs(kept_, n);
@@ -695,7 +704,7 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 		}
 		if (shellsA) {
 			pairs.emplace_back(a, b);
-			candidateSets_.push_back({linkedSet(a, shellsA), linkedSet(b, shellsB)});
+			pushWithHeadroom(candidateSets_, {linkedSet(a, shellsA), linkedSet(b, shellsB)});
 		}
 	}
 	if (linked_.size() < pairs.size()) resizeWithHeadroom(linked_, pairs.size());
@@ -716,9 +725,9 @@ std::size_t MSCCollider::memoryBytes() const {
 	std::size_t bytes = capacityBytes(covers_) + capacityBytes(shellRanges_) + capacityBytes(divisions_) +
 	                    capacityBytes(divisionStart_) + capacityBytes(frames_) + capacityBytes(boxes_) +
 	                    capacityBytes(extentLow_) + capacityBytes(extentHigh_) + capacityBytes(shellBlock_) +
-	                    capacityBytes(widened_) + capacityBytes(cellLow_) + capacityBytes(cellHigh_) +
+	                    capacityBytes(widened_) + capacityBytes(cellLow_) + capacityBytes(cellSpan_) +
 	                    capacityBytes(cellEntries_) + capacityBytes(cellShells_) + capacityBytes(cellStart_) +
-	                    capacityBytes(oversize_) + capacityBytes(isOversize_) + capacityBytes(shellFixed_) +
+	                    capacityBytes(oversize_) + capacityBytes(shellFixed_) +
 	                    capacityBytes(pairStart_) + capacityBytes(pairNext_) + capacityBytes(hits_) +
 	                    capacityBytes(candidateSets_) + capacityBytes(linked_) + capacityBytes(linkedSets_) +
 	                    capacityBytes(lists_) + capacityBytes(listTable_) + capacityBytes(listScratch_) +

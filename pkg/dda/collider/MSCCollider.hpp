@@ -252,13 +252,20 @@ private:
 	std::vector<int> shellBlock_;                  // per flat shell
 	std::vector<Eigen::AlignedBox3d> widened_;
 	using Cell = Eigen::Array<int, 3, 1>;   // a subspace's integer coordinates
-	std::vector<Cell> cellLow_, cellHigh_;  // per flat shell: the cells its box spans
+	// Per flat shell the cells its box spans: from cellLow_ on, span more per
+	// axis (at most kMaxCellsPerShell - 1), unless it is oversize.
+	struct CellSpan {
+		std::uint8_t x, y, z;
+		bool oversize;
+	};
+	std::vector<Cell> cellLow_;
+	std::vector<CellSpan> cellSpan_;
 	std::vector<std::pair<std::uint64_t, int>> cellEntries_;  // sparse keys: (cell key, shell), sorted
 	std::vector<int> cellShells_;             // every cell's shells, cell after cell
 	std::vector<std::uint32_t> cellStart_;    // dense keys: where each cell's shells start
 	bool denseGrid_ = false;
 	std::vector<int> oversize_;   // shells compared with every shell
-	std::vector<char> isOversize_, shellFixed_;
+	std::vector<char> shellFixed_;
 	std::vector<std::size_t> pairStart_, pairNext_;  // sortShellPairs' buckets
 	std::vector<ShellPair> hits_;
 	// Per candidate its two linked sets, until linked_ is filled.
