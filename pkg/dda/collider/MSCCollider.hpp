@@ -267,15 +267,14 @@ private:
 	std::vector<int> oversize_;   // shells compared with every shell
 	std::vector<char> shellFixed_;
 	std::vector<std::size_t> pairStart_, pairNext_;  // sortShellPairs' buckets
-	std::vector<ShellPair> hits_;
+	std::vector<ShellPair> hits_;  // without the cache: the shell pairs whose d0-boxes meet, sorted
 	// Per candidate its two linked sets, until linked_ is filled.
 	std::vector<std::array<int, 2>> candidateSets_;
 	std::vector<LinkedSubUnits> linked_;  // the first linkedCount_ are valid
 	int linkedCount_ = 0;
 	// Linked sets of every block, and the distinct sub-unit lists they use
 	// (blocks of one topology share them), found by hashing their contents
-	// (listTable_: open addressing, -1 = free). A list's buffer does not move
-	// when lists_ grows (vectors are moved), so views of it stay valid.
+	// (listTable_: open addressing, -1 = free).
 	std::vector<LinkedSet> linkedSets_;
 	std::vector<std::vector<int>> lists_;
 	std::vector<int> listTable_, listScratch_;
