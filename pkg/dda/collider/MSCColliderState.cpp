@@ -150,17 +150,20 @@ void MSCCollider::readState(StateReader& in, const std::vector<Block>& blocks) {
 				m.shellRanges_.push_back(range);
 			}
 		const ShellRange* vertexShells = m.shellRanges_.data() + c.firstSubUnit;
-		std::size_t lower = 0;  // points on shell j's lower plane, the last listed in m.divisions_
+		const auto same = [](const DivisionPoint& x, const DivisionPoint& y) {
+			return x.from == y.from && x.to == y.to && std::memcmp(&x.fraction, &y.fraction, sizeof(double)) == 0;
+		};
+		// Shell j lists the points on its lower plane (none for the first),
+		// the last plane appended to m.divisions_ (`lower` points), then
+		// those on its upper plane (none for the last), appended for shell j + 1.
+		if (c.shellCount > 0) m.divisionStart_.push_back(static_cast<int>(m.divisions_.size()));
+		std::size_t lower = 0;
 		for (int j = 0; j < c.shellCount; ++j) {
-			if (j == 0) m.divisionStart_.push_back(static_cast<int>(m.divisions_.size()));
 			std::vector<int> linkedCorners;
 			for (int v = 0; v < nv; ++v)
 				if (vertexShells[v].contains(j)) linkedCorners.push_back(v);
 			if (corners[j] != linkedCorners) bad("shell corners are not the vertices linked to the shell");
 			const std::vector<DivisionPoint>& points = divisions[j];
-			const auto same = [](const DivisionPoint& x, const DivisionPoint& y) {
-				return x.from == y.from && x.to == y.to && std::memcmp(&x.fraction, &y.fraction, sizeof(double)) == 0;
-			};
 			if (points.size() < lower || !std::equal(points.begin(), points.begin() + lower, m.divisions_.end() - lower, same))
 				bad("a shell's division points do not start with those of the shell below");
 			if (j + 1 == c.shellCount) {
