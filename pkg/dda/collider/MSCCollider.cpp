@@ -49,6 +49,48 @@ Vector3 faceNormal(const std::vector<int>& face, const std::vector<Vector3>& x) 
 	return area.normalized();
 }
 
+// A shell's box (min, max) and extent in its block's frame (low, high) as
+// its points p (c: p in the frame) are added.
+struct ShellBounds {
+	Vector3 min, max, low, high;
+	void reset() {
+		min = low = Vector3::Constant(std::numeric_limits<double>::infinity());
+		max = high = -min;
+	}
+	void add(const Vector3& p, const Vector3& c) {
+		min = min.cwiseMin(p);
+		max = max.cwiseMax(p);
+		low = low.cwiseMin(c);
+		high = high.cwiseMax(c);
+	}
+};
+
+// Resizes v to n elements: exactly the first time, with 1/8 spare capacity
+// when it must grow again (counts creep up from call to call; resize would
+// double the capacity).
+template <class T>
+void resizeWithHeadroom(std::vector<T>& v, std::size_t n) {
+	if (n > v.capacity()) v.reserve(v.capacity() == 0 ? n : n + n / 8);
+	v.resize(n);
+}
+
+// Appends x, the capacity growing by 1/8 when full (not doubling: the arrays
+// so filled are kept from call to call at their largest size).
+template <class T>
+void pushWithHeadroom(std::vector<T>& v, const T& x) {
+	if (v.size() == v.capacity()) v.reserve(v.size() + v.size() / 8 + 64);
+	v.push_back(x);
+}
+
+std::uint64_t hashList(const std::vector<int>& list) {
+	std::uint64_t h = list.size();
+	for (int i : list) {
+		h = (h ^ static_cast<std::uint32_t>(i)) * 0x9E3779B97F4A7C15ULL;
+		h ^= h >> 29;
+	}
+	return h;
+}
+
 }  // namespace
 
 MSCCollider::MSCCollider(double criticalLengthFactor, int segments)
@@ -90,16 +132,22 @@ const Eigen::AlignedBox3d& MSCCollider::shellBox(int block, int shell) const {
 	return boxes_[cover.firstShell + shell];
 }
 
-void MSCCollider::buildCover(const Block& block, double criticalLength, int segments, BlockCover& cover) const {
+void MSCCollider::buildCover(const Block& block, double criticalLength, int segments, BlockCover& cover,
+                             std::vector<ShellRange>& shellRanges, std::vector<DivisionPoint>& divisions,
+                             std::vector<int>& divisionStart) const {
 	const ConvexPolyhedron& shape = *block.shape;
 	const std::vector<Vector3>& x = block.vertices;
 	const int nv = static_cast<int>(x.size());
 	const int ne = static_cast<int>(shape.edges.size());
 	const int nf = static_cast<int>(shape.faces.size());
-	cover.shape = block.shape.get();
+	cover.shape = block.shape;
 	cover.criticalLength = criticalLength;
 	cover.segments = segments;
 	cover.boxesBuilt = false;
+	cover.firstSubUnit = static_cast<int>(shellRanges.size());
+	cover.vertexCount = nv;
+	cover.edgeCount = ne;
+	cover.faceCount = nf;
 	Eigen::AlignedBox3d box;
 	for (const Vector3& p : x) box.extend(p);
 	cover.widening = kShellWideningRelative * box.diagonal().norm();
@@ -107,8 +155,6 @@ void MSCCollider::buildCover(const Block& block, double criticalLength, int segm
 	for (const auto& e : shape.edges) longest = std::max(longest, (x[e[1]] - x[e[0]]).norm());
 	const int k = longest > criticalLength ? segments : 1;
 	cover.shellCount = k;
-	cover.shells.assign(k, Shell{});
-	cover.linkedSets.clear();
 	// Main axis: the principal direction of largest spread of the corners.
 	Vector3 mean = Vector3::Zero();
 	for (const Vector3& p : x) mean += p;
@@ -140,10 +186,8 @@ void MSCCollider::buildCover(const Block& block, double criticalLength, int segm
 		if (f3 >= 0 && std::abs(normals[f3].dot(across)) >= kMinFrameDeterminant) cover.frameFaces = {f1, f2, f3};
 	}
 	if (k == 1) {
-		for (int v = 0; v < nv; ++v) cover.shells[0].corners.push_back(v);
-		cover.vertexShells.assign(nv, 1);
-		cover.edgeShells.assign(ne, 1);
-		cover.faceShells.assign(nf, 1);
+		shellRanges.insert(shellRanges.end(), nv + ne + nf, ShellRange::of(1));
+		divisionStart.push_back(static_cast<int>(divisions.size()));
 		return;
 	}
 	std::vector<double> s(nv);
@@ -153,41 +197,38 @@ void MSCCollider::buildCover(const Block& block, double criticalLength, int segm
 	std::vector<double> bound(k + 1);
 	for (int j = 0; j <= k; ++j) bound[j] = low + (high - low) * j / k;
 	bound[k] = high;
+	// The slabs an interval [lo, hi] touches: consecutive ones (the bounds
+	// ascend, except that bound[k - 1] may pass bound[k] by round-off, which
+	// only drops slab k - 1), so a range.
 	const auto shellsOf = [&](double lo, double hi) {
 		std::uint64_t mask = 0;
 		for (int j = 0; j < k; ++j)
 			if (lo <= bound[j + 1] && hi >= bound[j]) mask |= std::uint64_t{1} << j;
-		return mask;
+		return ShellRange::of(mask);
 	};
-	cover.vertexShells.resize(nv);
-	for (int v = 0; v < nv; ++v) cover.vertexShells[v] = shellsOf(s[v], s[v]);
-	cover.edgeShells.resize(ne);
+	for (int v = 0; v < nv; ++v) shellRanges.push_back(shellsOf(s[v], s[v]));
 	for (int e = 0; e < ne; ++e) {
 		const double s0 = s[shape.edges[e][0]], s1 = s[shape.edges[e][1]];
-		cover.edgeShells[e] = shellsOf(std::min(s0, s1), std::max(s0, s1));
+		shellRanges.push_back(shellsOf(std::min(s0, s1), std::max(s0, s1)));
 	}
-	cover.faceShells.resize(nf);
 	for (int f = 0; f < nf; ++f) {
 		double lo = s[shape.faces[f][0]], hi = lo;
 		for (int v : shape.faces[f]) {
 			lo = std::min(lo, s[v]);
 			hi = std::max(hi, s[v]);
 		}
-		cover.faceShells[f] = shellsOf(lo, hi);
+		shellRanges.push_back(shellsOf(lo, hi));
 	}
+	// Division points on the slabs' inner planes (the outer ends hold
+	// corners), each plane's listed with the slab above it.
 	for (int j = 0; j < k; ++j) {
-		Shell& shell = cover.shells[j];
-		for (int v = 0; v < nv; ++v)
-			if (cover.vertexShells[v] >> j & 1) shell.corners.push_back(v);
-		// Division points on the slab's inner planes (its outer ends hold corners).
-		for (int side = 0; side < 2; ++side) {
-			if ((side == 0 && j == 0) || (side == 1 && j == k - 1)) continue;
-			const double plane = bound[j + side];
-			for (int e = 0; e < ne; ++e) {
-				const double s0 = s[shape.edges[e][0]], s1 = s[shape.edges[e][1]];
-				if (std::min(s0, s1) < plane && plane < std::max(s0, s1))
-					shell.divisions.push_back({e, std::clamp((plane - s0) / (s1 - s0), 0.0, 1.0)});
-			}
+		divisionStart.push_back(static_cast<int>(divisions.size()));
+		if (j == 0) continue;
+		const double plane = bound[j];
+		for (int e = 0; e < ne; ++e) {
+			const double s0 = s[shape.edges[e][0]], s1 = s[shape.edges[e][1]];
+			if (std::min(s0, s1) < plane && plane < std::max(s0, s1))
+				divisions.push_back({shape.edges[e][0], shape.edges[e][1], std::clamp((plane - s0) / (s1 - s0), 0.0, 1.0)});
 		}
 	}
 }
@@ -205,23 +246,34 @@ void MSCCollider::updateBoxes(const Block& block, BlockCover& cover, Frame& fram
 	frame.dual = frame.axes.inverse();
 	frame.origin = x.front();
 	frame.reach = 0;
-	for (int s = cover.firstShell; s < cover.firstShell + cover.shellCount; ++s) {
-		Vector3 min = Vector3::Constant(std::numeric_limits<double>::infinity()), max = -min;
-		Vector3 low = min, high = max;
-		for (int k = pointStart_[s]; k < pointStart_[s + 1]; ++k) {
-			const ShellPoint& point = points_[k];
-			const Vector3& from = x[point.from];
-			const Vector3 p = point.from == point.to ? from : Vector3(from + point.fraction * (x[point.to] - from));
-			min = min.cwiseMin(p);
-			max = max.cwiseMax(p);
+	// Each point is computed once and added to the shells it lies in: a
+	// vertex to its linked shells, a division point to the two slabs of its
+	// plane. A shell gets its corners, then the points on its lower plane,
+	// then those on its upper one (the order of the saved per-shell lists).
+	std::array<ShellBounds, kMaxSegments> bounds;
+	const int k = cover.shellCount;
+	for (int j = 0; j < k; ++j) bounds[j].reset();
+	const ShellRange* vertexShells = shellRanges_.data() + cover.firstSubUnit;
+	for (int v = 0; v < cover.vertexCount; ++v) {
+		const Vector3 c = frame.axes * (x[v] - frame.origin);
+		for (int j = vertexShells[v].first; j <= vertexShells[v].last; ++j) bounds[j].add(x[v], c);
+	}
+	for (int j = 1; j < k; ++j) {
+		const int s = cover.firstShell + j;
+		for (int d = divisionStart_[s]; d < divisionStart_[s + 1]; ++d) {
+			const Vector3& from = x[divisions_[d].from];
+			const Vector3 p = from + divisions_[d].fraction * (x[divisions_[d].to] - from);
 			const Vector3 c = frame.axes * (p - frame.origin);
-			low = low.cwiseMin(c);
-			high = high.cwiseMax(c);
+			bounds[j - 1].add(p, c);
+			bounds[j].add(p, c);
 		}
-		boxes_[s] = Eigen::AlignedBox3d(min, max);
-		extentLow_[s] = low;
-		extentHigh_[s] = high;
-		frame.reach = std::max({frame.reach, low.cwiseAbs().maxCoeff(), high.cwiseAbs().maxCoeff()});
+	}
+	for (int j = 0; j < k; ++j) {
+		const int s = cover.firstShell + j;
+		boxes_[s] = Eigen::AlignedBox3d(bounds[j].min, bounds[j].max);
+		extentLow_[s] = bounds[j].low;
+		extentHigh_[s] = bounds[j].high;
+		frame.reach = std::max({frame.reach, bounds[j].low.cwiseAbs().maxCoeff(), bounds[j].high.cwiseAbs().maxCoeff()});
 	}
 	cover.boxesBuilt = block.fixed;
 	totalShellUpdates_ += cover.shellCount;
@@ -234,44 +286,67 @@ void MSCCollider::layoutShells() {
 		cover.boxesBuilt = false;
 		total += cover.shellCount;
 	}
-	boxes_.resize(total);
-	extentLow_.resize(total);
-	extentHigh_.resize(total);
-	shellBlock_.resize(total);
-	shellIndex_.resize(total);
-	frames_.resize(covers_.size());
-	points_.clear();
-	pointStart_.assign(1, 0);
+	resizeWithHeadroom(boxes_, total);
+	resizeWithHeadroom(extentLow_, total);
+	resizeWithHeadroom(extentHigh_, total);
+	resizeWithHeadroom(shellBlock_, total);
+	resizeWithHeadroom(frames_, covers_.size());
 	for (int b = 0; b < static_cast<int>(covers_.size()); ++b)
-		for (int j = 0; j < covers_[b].shellCount; ++j) {
-			shellBlock_[covers_[b].firstShell + j] = b;
-			shellIndex_[covers_[b].firstShell + j] = j;
-			const Shell& shell = covers_[b].shells[j];
-			for (int v : shell.corners) points_.push_back({v, v, 0.0});
-			if (covers_[b].shape)  // (else not built yet: no shells)
-				for (const DivisionPoint& d : shell.divisions) {
-					const auto& edge = covers_[b].shape->edges[d.edge];
-					points_.push_back({edge[0], edge[1], d.fraction});
-				}
-			pointStart_.push_back(static_cast<int>(points_.size()));
-		}
+		std::fill_n(shellBlock_.begin() + covers_[b].firstShell, covers_[b].shellCount, b);
+	clearLinkedSets();
 	cacheValid_ = false;
 }
 
-int MSCCollider::linkedSet(BlockCover& cover, std::uint64_t shells) {
-	const int count = static_cast<int>(cover.linkedSets.size());
-	for (int k = 0; k < count; ++k)
-		if (cover.linkedSets[k].shells == shells) return k;
-	LinkedSet& set = cover.linkedSets.emplace_back();
-	set.shells = shells;
-	const auto collect = [shells](const std::vector<std::uint64_t>& linkedShells, std::vector<int>& out) {
-		for (int i = 0; i < static_cast<int>(linkedShells.size()); ++i)
-			if (linkedShells[i] & shells) out.push_back(i);
+int MSCCollider::linkedSet(int block, std::uint64_t shells) {
+	BlockCover& cover = covers_[block];
+	for (int k = cover.linkedSets; k >= 0; k = linkedSets_[k].next)
+		if (linkedSets_[k].shells == shells) return k;
+	LinkedSet set{shells, cover.linkedSets, {}};
+	const ShellRange* linkedShells = shellRanges_.data() + cover.firstSubUnit;
+	const int counts[3] = {cover.vertexCount, cover.edgeCount, cover.faceCount};
+	for (int kind = 0; kind < 3; ++kind) {
+		listScratch_.clear();
+		for (int i = 0; i < counts[kind]; ++i)
+			if (linkedShells[i].mask() & shells) listScratch_.push_back(i);
+		linkedShells += counts[kind];
+		set.lists[kind] = internList(listScratch_);
+	}
+	cover.linkedSets = static_cast<int>(linkedSets_.size());
+	pushWithHeadroom(linkedSets_, set);
+	if (static_cast<std::size_t>(++cover.linkedSetCount) > kMaxLinkedSetsPerBlock) linkedSetsOverflow_ = true;
+	return cover.linkedSets;
+}
+
+int MSCCollider::internList(const std::vector<int>& list) {
+	const auto place = [this](int k) {
+		const std::size_t mask = listTable_.size() - 1;
+		std::size_t slot = hashList(lists_[k]) & mask;
+		while (listTable_[slot] >= 0) slot = (slot + 1) & mask;
+		listTable_[slot] = k;
 	};
-	collect(cover.vertexShells, set.vertices);
-	collect(cover.edgeShells, set.edges);
-	collect(cover.faceShells, set.faces);
-	return count;
+	// The table is kept at most half full (a power of two).
+	if (2 * (lists_.size() + 1) > listTable_.size()) {
+		listTable_.assign(std::max<std::size_t>(64, 2 * listTable_.size()), -1);
+		for (int k = 0; k < static_cast<int>(lists_.size()); ++k) place(k);
+	}
+	const std::size_t mask = listTable_.size() - 1;
+	std::size_t slot = hashList(list) & mask;
+	for (; listTable_[slot] >= 0; slot = (slot + 1) & mask)
+		if (lists_[listTable_[slot]] == list) return listTable_[slot];
+	listTable_[slot] = static_cast<int>(lists_.size());
+	lists_.push_back(list);
+	return listTable_[slot];
+}
+
+void MSCCollider::clearLinkedSets() {
+	linkedSets_.clear();
+	lists_.clear();
+	std::fill(listTable_.begin(), listTable_.end(), -1);
+	for (BlockCover& cover : covers_) {
+		cover.linkedSets = -1;
+		cover.linkedSetCount = 0;
+	}
+	linkedSetsOverflow_ = false;
 }
 
 long MSCCollider::gridSearch(const std::vector<Block>& blocks, const std::vector<Eigen::AlignedBox3d>& boxes,
@@ -296,22 +371,23 @@ long MSCCollider::gridSearch(const std::vector<Block>& blocks, const std::vector
 	const Vector3 origin = domain.min();
 	const double cell = std::max(sideSum / shellTotal, domain.sizes().maxCoeff() / kMaxCellsPerAxis);
 	const auto cellOf = [&](const Vector3& x) {
-		return ((x - origin) / cell).array().floor().cast<long>().min(kMaxCellsPerAxis - 1).max(0).eval();
+		return ((x - origin) / cell).array().floor().cast<long>().min(kMaxCellsPerAxis - 1).max(0).cast<int>().eval();
 	};
-	const Cell dims = cellOf(domain.max()) + 1;
-	cellLow_.resize(shellTotal);
-	cellHigh_.resize(shellTotal);
+	const Eigen::Array<long, 3, 1> dims = cellOf(domain.max()).cast<long>() + 1;
+	resizeWithHeadroom(cellLow_, shellTotal);
+	resizeWithHeadroom(cellSpan_, shellTotal);
 	oversize_.clear();
-	isOversize_.assign(shellTotal, 0);
 	std::size_t entries = 0;
 	for (int s = 0; s < shellTotal; ++s) {
 		cellLow_[s] = cellOf(boxes[s].min());
-		cellHigh_[s] = cellOf(boxes[s].max());
-		const long span = (cellHigh_[s] - cellLow_[s] + 1).prod();
+		const Cell extra = cellOf(boxes[s].max()) - cellLow_[s];
+		const long span = (extra + 1).cast<long>().prod();
 		if (span > kMaxCellsPerShell) {
 			oversize_.push_back(s);
-			isOversize_[s] = 1;
+			cellSpan_[s] = CellSpan{0, 0, 0, true};
 		} else {
+			cellSpan_[s] = CellSpan{static_cast<std::uint8_t>(extra.x()), static_cast<std::uint8_t>(extra.y()),
+			                        static_cast<std::uint8_t>(extra.z()), false};
 			entries += static_cast<std::size_t>(span);
 		}
 	}
@@ -329,7 +405,7 @@ long MSCCollider::gridSearch(const std::vector<Block>& blocks, const std::vector
 	};
 	// Per shell its block's fixed flag, read from one compact array (the
 	// blocks themselves are large and far apart in memory).
-	shellFixed_.resize(shellTotal);
+	resizeWithHeadroom(shellFixed_, shellTotal);
 	for (int s = 0; s < shellTotal; ++s) shellFixed_[s] = blocks[shellBlock_[s]].fixed;
 	// Compares shells s and t if `mine` (this is where the pair is compared):
 	// a test when their blocks differ and are not both fixed, a shell pair
@@ -344,7 +420,7 @@ long MSCCollider::gridSearch(const std::vector<Block>& blocks, const std::vector
 		const bool meet = (lowS.x() <= highT.x()) & (lowT.x() <= highS.x()) & (lowS.y() <= highT.y()) &
 		                  (lowT.y() <= highS.y()) & (lowS.z() <= highT.z()) & (lowT.z() <= highS.z());
 		tests += mine & pair;
-		if (mine & pair & meet) out.push_back(a < b ? ShellPair{a, b, s, t} : ShellPair{b, a, t, s});
+		if (mine & pair & meet) pushWithHeadroom(out, a < b ? ShellPair{s, t} : ShellPair{t, s});
 	};
 	// The shells of cell `here`: cellShells_[first, last), ascending; a pair
 	// is compared in the cell of the max of its lowest cells only.
@@ -357,32 +433,33 @@ long MSCCollider::gridSearch(const std::vector<Block>& blocks, const std::vector
 	};
 	const auto forEachCellOf = [&](int s, const auto& visit) {
 		const Cell& lo = cellLow_[s];
-		const Cell& hi = cellHigh_[s];
-		for (long i = lo.x(); i <= hi.x(); ++i)
-			for (long j = lo.y(); j <= hi.y(); ++j)
-				for (long k = lo.z(); k <= hi.z(); ++k) visit(key(Cell(i, j, k)));
+		const Cell hi = lo + Cell(cellSpan_[s].x, cellSpan_[s].y, cellSpan_[s].z);
+		for (int i = lo.x(); i <= hi.x(); ++i)
+			for (int j = lo.y(); j <= hi.y(); ++j)
+				for (int k = lo.z(); k <= hi.z(); ++k) visit(key(Cell(i, j, k)));
 	};
-	cellShells_.resize(entries);
+	resizeWithHeadroom(cellShells_, entries);
 	if (dense) {
 		// Counting sort: count per cell, prefix sums (cellStart_[c + 1] = end
 		// of cell c), then shells placed from the last down, so each cell's
-		// shells ascend and cellStart_[c] ends at the cell's first entry.
+		// shells ascend and cellStart_[c + 1] ends at the cell's first entry.
 		const std::size_t cells = static_cast<std::size_t>(denseCells);
-		cellStart_.assign(cells + 1, 0);
+		resizeWithHeadroom(cellStart_, cells + 2);
+		std::fill(cellStart_.begin(), cellStart_.end(), 0);
 		for (int s = 0; s < shellTotal; ++s)
-			if (!isOversize_[s]) forEachCellOf(s, [&](std::uint64_t c) { ++cellStart_[c + 1]; });
+			if (!cellSpan_[s].oversize) forEachCellOf(s, [&](std::uint64_t c) { ++cellStart_[c + 1]; });
 		for (std::size_t c = 0; c < cells; ++c) cellStart_[c + 1] += cellStart_[c];
 		for (int s = shellTotal - 1; s >= 0; --s)
-			if (!isOversize_[s]) forEachCellOf(s, [&](std::uint64_t c) { cellShells_[--cellStart_[c + 1]] = s; });
+			if (!cellSpan_[s].oversize) forEachCellOf(s, [&](std::uint64_t c) { cellShells_[--cellStart_[c + 1]] = s; });
 		// Now cellStart_[c + 1] is the start of cell c; cell c is [cellStart_[c + 1], cellStart_[c + 2]).
-		cellStart_.push_back(static_cast<std::uint32_t>(entries));
+		cellStart_[cells + 1] = static_cast<std::uint32_t>(entries);
 		for (std::size_t c = 0; c < cells; ++c)
 			if (cellStart_[c + 2] - cellStart_[c + 1] > 1) scanCell(c, cellStart_[c + 1], cellStart_[c + 2]);
 	} else {
 		cellEntries_.clear();
 		cellEntries_.reserve(entries);
 		for (int s = 0; s < shellTotal; ++s)
-			if (!isOversize_[s]) forEachCellOf(s, [&](std::uint64_t c) { cellEntries_.emplace_back(c, s); });
+			if (!cellSpan_[s].oversize) forEachCellOf(s, [&](std::uint64_t c) { cellEntries_.emplace_back(c, s); });
 		std::sort(cellEntries_.begin(), cellEntries_.end());
 		for (std::size_t p = 0; p < entries; ++p) cellShells_[p] = cellEntries_[p].second;
 		for (std::size_t first = 0; first < entries;) {
@@ -394,25 +471,34 @@ long MSCCollider::gridSearch(const std::vector<Block>& blocks, const std::vector
 	}
 	for (int s : oversize_)
 		for (int t = 0; t < shellTotal; ++t)
-			if (t != s && (!isOversize_[t] || s < t)) compare(s, t, true);
+			if (t != s && (!cellSpan_[t].oversize || s < t)) compare(s, t, true);
 	return tests;
 }
 
 void MSCCollider::sortShellPairs(std::vector<ShellPair>& pairs, int blocks) {
-	// By counting on the first block (stable), then each block's few pairs
-	// by (b, s, t): the order of ShellPair::operator<.
+	// By counting on the first block, in place: bucket b is [pairStart_[b],
+	// pairStart_[b + 1]), filled up to pairNext_[b]; a pair found in another
+	// block's bucket is swapped to that bucket's next place. Then each block's
+	// few pairs by (t, s): flat shells go block after block, so the pairs of
+	// each second block follow one another, in ascending order (the order
+	// within a block pair changes nothing downstream).
 	pairStart_.assign(static_cast<std::size_t>(blocks) + 1, 0);
-	for (const ShellPair& p : pairs) ++pairStart_[p.a + 1];
+	for (const ShellPair& p : pairs) ++pairStart_[shellBlock_[p.s] + 1];
 	for (int b = 0; b < blocks; ++b) pairStart_[b + 1] += pairStart_[b];
-	sortedPairs_.resize(pairs.size());
-	for (const ShellPair& p : pairs) sortedPairs_[pairStart_[p.a]++] = p;
-	pairs.swap(sortedPairs_);
-	std::size_t first = 0;
-	for (int b = 0; b < blocks; ++b) {
-		const std::size_t last = pairStart_[b];  // now the end of block b's pairs
-		if (last - first > 1) std::sort(pairs.begin() + first, pairs.begin() + last);
-		first = last;
-	}
+	pairNext_.assign(pairStart_.begin(), pairStart_.end() - 1);
+	for (int b = 0; b < blocks; ++b)
+		while (pairNext_[b] < pairStart_[b + 1]) {
+			ShellPair& p = pairs[pairNext_[b]];
+			const int home = shellBlock_[p.s];
+			if (home == b)
+				++pairNext_[b];
+			else
+				std::swap(p, pairs[pairNext_[home]++]);
+		}
+	const auto before = [](const ShellPair& x, const ShellPair& y) { return x.t < y.t || (x.t == y.t && x.s < y.s); };
+	for (int b = 0; b < blocks; ++b)
+		if (pairStart_[b + 1] - pairStart_[b] > 1)
+			std::sort(pairs.begin() + pairStart_[b], pairs.begin() + pairStart_[b + 1], before);
 }
 
 bool MSCCollider::apartInFrame(int s, int t, const Eigen::Matrix3d& m, const Eigen::Matrix3d& size,
@@ -432,15 +518,12 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 
 	// Topology: the block count changed (all), a block's shape changed, or the
 	// cover's parameters changed (blocks whose parameters differ).
-	bool layoutChanged = false;
-	if (static_cast<int>(covers_.size()) != n) {
-		covers_.assign(n, BlockCover{});
-		layoutChanged = true;
-	}
+	if (linkedSetsOverflow_) clearLinkedSets();
+	if (static_cast<int>(covers_.size()) != n) covers_.assign(n, BlockCover{});
+	std::vector<std::pair<int, Override>> builds;  // the covers to build, with their parameters
 	for (int b = 0; b < n; ++b) {
-		BlockCover& cover = covers_[b];
-		if (cover.linkedSets.size() > kMaxLinkedSetsPerBlock) cover.linkedSets.clear();
-		const bool fresh = cover.shape != blocks[b].shape.get();
+		const BlockCover& cover = covers_[b];
+		const bool fresh = cover.shape != blocks[b].shape;
 		if (!fresh && !coverChanged_) continue;
 		const auto own = overrides_.find(b);
 		const double criticalLength = own != overrides_.end() ? own->second.criticalLength
@@ -448,13 +531,43 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 		                                                     : criticalLengthFactor_ * blockSize(blocks[b]);
 		const int segments = own != overrides_.end() ? own->second.segments : segments_;
 		if (!fresh && criticalLength == cover.criticalLength && segments == cover.segments) continue;
-		buildCover(blocks[b], criticalLength, segments, cover);
-		++coverBuilds_;
-		layoutChanged = true;
+		builds.push_back({b, Override{criticalLength, segments}});
 	}
 	coverChanged_ = false;
-	if (layoutChanged) layoutShells();
-	const int shellTotal = static_cast<int>(boxes_.size());
+	if (!builds.empty()) {
+		// New covers' parts, with the others' copied, block after block.
+		std::vector<ShellRange> shellRanges;
+		std::vector<DivisionPoint> divisions;
+		std::vector<int> divisionStart;
+		auto build = builds.begin();
+		for (int b = 0; b < n; ++b) {
+			BlockCover& cover = covers_[b];
+			if (build != builds.end() && build->first == b) {
+				buildCover(blocks[b], build->second.criticalLength, build->second.segments, cover, shellRanges,
+				           divisions, divisionStart);
+				++build;
+				++coverBuilds_;
+				continue;
+			}
+			const auto ranges = shellRanges_.begin() + cover.firstSubUnit;
+			cover.firstSubUnit = static_cast<int>(shellRanges.size());
+			shellRanges.insert(shellRanges.end(), ranges, ranges + cover.vertexCount + cover.edgeCount + cover.faceCount);
+			for (int s = cover.firstShell; s < cover.firstShell + cover.shellCount; ++s) {
+				divisionStart.push_back(static_cast<int>(divisions.size()));
+				divisions.insert(divisions.end(), divisions_.begin() + divisionStart_[s],
+				                 divisions_.begin() + divisionStart_[s + 1]);
+			}
+		}
+		divisionStart.resize(divisionStart.size() + 2, static_cast<int>(divisions.size()));
+		shellRanges.shrink_to_fit();  // (they grew by doubling)
+		divisions.shrink_to_fit();
+		divisionStart.shrink_to_fit();
+		shellRanges_ = std::move(shellRanges);
+		divisions_ = std::move(divisions);
+		divisionStart_ = std::move(divisionStart);
+		layoutShells();
+	}
+	const int shellTotal = static_cast<int>(shellBlock_.size());
 	stats.shells = shellTotal;
 
 	// Boxes, frames and extents: moving blocks every call, fixed blocks once.
@@ -466,7 +579,7 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 
 	const double margin = kBroadPhaseMarginFactor * contactDistance;
 	const double searchMargin = margin * (1 + kVerletSkinFactor);
-	widened_.resize(shellTotal);
+	resizeWithHeadroom(widened_, shellTotal);
 	for (int s = 0; s < shellTotal; ++s) {
 		const Vector3 w = Vector3::Constant(margin + covers_[shellBlock_[s]].widening);
 		widened_[s] = Eigen::AlignedBox3d(boxes_[s].min() - w, boxes_[s].max() + w);
@@ -476,7 +589,8 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 		return Eigen::AlignedBox3d(boxes_[s].min() - w, boxes_[s].max() + w);
 	};
 
-	// Shell pairs whose d0-boxes meet, sorted.
+	// Shell pairs whose d0-boxes meet, sorted: hits_, or those of cached_
+	// whose d0-boxes meet (tested below).
 	hits_.clear();
 	if (!reuse_) {
 		cacheValid_ = false;
@@ -504,7 +618,7 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 		}
 		if (!full && static_cast<double>(movers_.size()) > kVerletPartialFactor * std::log2(std::max(2, n))) full = true;
 		if (full) {
-			searchBoxes_.resize(shellTotal);
+			resizeWithHeadroom(searchBoxes_, shellTotal);
 			for (int s = 0; s < shellTotal; ++s) searchBoxes_[s] = searchBox(s);
 			searchedFixed_.resize(n);
 			for (int b = 0; b < n; ++b) searchedFixed_[b] = blocks[b].fixed;
@@ -524,7 +638,7 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 				}
 				kept_.clear();
 				for (const ShellPair& p : cached_)
-					if (!moved_[p.a] && !moved_[p.b]) kept_.push_back(p);
+					if (!moved_[shellBlock_[p.s]] && !moved_[shellBlock_[p.t]]) pushWithHeadroom(kept_, p);
 				stats.pairsReused = static_cast<long>(kept_.size());
 				for (int m : movers_) {
 					const BlockCover& cover = covers_[m];
@@ -534,7 +648,7 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 							if (b == m || (moved_[b] && b < m) || (blocks[b].fixed && blocks[m].fixed)) continue;
 							++stats.shellTests;
 							if (searchBoxes_[s].intersects(searchBoxes_[t]))
-								kept_.push_back(m < b ? ShellPair{m, b, s, t} : ShellPair{b, m, t, s});
+								pushWithHeadroom(kept_, m < b ? ShellPair{s, t} : ShellPair{t, s});
 						}
 				}
 				sortShellPairs(kept_, n);
@@ -543,56 +657,64 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 				stats.pairsReused = static_cast<long>(cached_.size());
 			}
 		}
-		for (const ShellPair& p : cached_)
-			if (widened_[p.s].intersects(widened_[p.t])) hits_.push_back(p);
-		stats.shellTests += static_cast<long>(cached_.size());
 	}
 
 	// Per block pair: the shell pairs that also overlap in both frames, and
-	// the union of their shells.
-	candidates_.clear();
-	for (std::size_t h = 0; h < hits_.size();) {
-		const int a = hits_[h].a, b = hits_[h].b;
+	// the union of their shells; a candidate links the union's sub-units
+	// (lists shared per block and shell set).
+	const std::vector<ShellPair>& tested = reuse_ ? cached_ : hits_;
+	candidateSets_.clear();
+	for (std::size_t h = 0; h < tested.size();) {
+		const int a = shellBlock_[tested[h].s], b = shellBlock_[tested[h].t];
 		std::size_t end = h + 1;
-		while (end < hits_.size() && hits_[end].a == a && hits_[end].b == b) ++end;
-		const Frame& fa = frames_[a];
-		const Frame& fb = frames_[b];
-		const Vector3 between = fb.origin - fa.origin;
-		const Eigen::Matrix3d inA = fa.axes * fb.dual, inB = fb.axes * fa.dual;
-		const Eigen::Matrix3d sizeInA = inA.cwiseAbs(), sizeInB = inB.cwiseAbs();
-		const Vector3 offsetInA = fa.axes * between, offsetInB = fb.axes * (-between);
-		const double roundoff =
-		    kFrameRoundoffRelative * (between.cwiseAbs().sum() + 10 * (fa.reach + fb.reach));
-		const double limit = 2 * margin + covers_[a].widening + covers_[b].widening + roundoff;
-		Candidate c{a, b, 0, 0};
+		while (end < tested.size() && shellBlock_[tested[end].s] == a && shellBlock_[tested[end].t] == b) ++end;
+		// The frames' terms, when a shell pair's d0-boxes meet.
+		bool framed = false;
+		Eigen::Matrix3d inA, inB, sizeInA, sizeInB;
+		Vector3 offsetInA, offsetInB;
+		double limit = 0;
+		std::uint64_t shellsA = 0, shellsB = 0;
 		for (; h < end; ++h) {
-			const int s = hits_[h].s, t = hits_[h].t;
+			const int s = tested[h].s, t = tested[h].t;
+			if (reuse_) {
+				++stats.shellTests;
+				if (!widened_[s].intersects(widened_[t])) continue;
+			}
+			if (!framed) {
+				const Frame& fa = frames_[a];
+				const Frame& fb = frames_[b];
+				const Vector3 between = fb.origin - fa.origin;
+				inA = fa.axes * fb.dual;
+				inB = fb.axes * fa.dual;
+				sizeInA = inA.cwiseAbs();
+				sizeInB = inB.cwiseAbs();
+				offsetInA = fa.axes * between;
+				offsetInB = fb.axes * (-between);
+				const double roundoff =
+				    kFrameRoundoffRelative * (between.cwiseAbs().sum() + 10 * (fa.reach + fb.reach));
+				limit = 2 * margin + covers_[a].widening + covers_[b].widening + roundoff;
+				framed = true;
+			}
 			++stats.shellTests;
 			if (apartInFrame(s, t, inA, sizeInA, offsetInA, limit) || apartInFrame(t, s, inB, sizeInB, offsetInB, limit))
 				continue;
 			++stats.shellPairs;
-			c.shellsA |= std::uint64_t{1} << shellIndex_[s];
-			c.shellsB |= std::uint64_t{1} << shellIndex_[t];
+			shellsA |= std::uint64_t{1} << (s - covers_[a].firstShell);
+			shellsB |= std::uint64_t{1} << (t - covers_[b].firstShell);
 		}
-		if (c.shellsA) candidates_.push_back(c);
+		if (shellsA) {
+			pairs.emplace_back(a, b);
+			pushWithHeadroom(candidateSets_, {linkedSet(a, shellsA), linkedSet(b, shellsB)});
+		}
 	}
-
-	// One candidate per block pair, linking the union of its overlapping
-	// shells' sub-units (lists shared per block and shell set; all are built
-	// before any is referenced).
-	for (Candidate& c : candidates_) {
-		c.setA = linkedSet(covers_[c.a], c.shellsA);
-		c.setB = linkedSet(covers_[c.b], c.shellsB);
-	}
-	if (linked_.size() < candidates_.size()) linked_.resize(candidates_.size());
-	for (const Candidate& c : candidates_) {
-		pairs.emplace_back(c.a, c.b);
+	if (linked_.size() < pairs.size()) resizeWithHeadroom(linked_, pairs.size());
+	for (const std::array<int, 2>& sets : candidateSets_) {
 		LinkedSubUnits& out = linked_[linkedCount_++];
-		const LinkedSet* sets[2] = {&covers_[c.a].linkedSets[c.setA], &covers_[c.b].linkedSets[c.setB]};
 		for (int i = 0; i < 2; ++i) {
-			out.vertices[i] = SubUnitList(sets[i]->vertices);
-			out.edges[i] = SubUnitList(sets[i]->edges);
-			out.faces[i] = SubUnitList(sets[i]->faces);
+			const std::array<int, 3>& lists = linkedSets_[sets[i]].lists;
+			out.vertices[i] = SubUnitList(lists_[lists[0]]);
+			out.edges[i] = SubUnitList(lists_[lists[1]]);
+			out.faces[i] = SubUnitList(lists_[lists[2]]);
 		}
 		stats.subUnitPairs += out.subUnitPairs();
 	}
@@ -600,23 +722,19 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 }
 
 std::size_t MSCCollider::memoryBytes() const {
-	std::size_t bytes = capacityBytes(covers_) + capacityBytes(frames_) + capacityBytes(boxes_) +
-	                    capacityBytes(extentLow_) + capacityBytes(extentHigh_) + capacityBytes(points_) +
-	                    capacityBytes(pointStart_) + capacityBytes(shellBlock_) + capacityBytes(shellIndex_) +
-	                    capacityBytes(widened_) + capacityBytes(cellLow_) + capacityBytes(cellHigh_) +
+	std::size_t bytes = capacityBytes(covers_) + capacityBytes(shellRanges_) + capacityBytes(divisions_) +
+	                    capacityBytes(divisionStart_) + capacityBytes(frames_) + capacityBytes(boxes_) +
+	                    capacityBytes(extentLow_) + capacityBytes(extentHigh_) + capacityBytes(shellBlock_) +
+	                    capacityBytes(widened_) + capacityBytes(cellLow_) + capacityBytes(cellSpan_) +
 	                    capacityBytes(cellEntries_) + capacityBytes(cellShells_) + capacityBytes(cellStart_) +
-	                    capacityBytes(oversize_) + capacityBytes(isOversize_) + capacityBytes(shellFixed_) +
-	                    capacityBytes(pairStart_) + capacityBytes(sortedPairs_) + capacityBytes(hits_) +
-	                    capacityBytes(candidates_) + capacityBytes(linked_) + capacityBytes(searchBoxes_) +
-	                    capacityBytes(cached_) + capacityBytes(kept_) + capacityBytes(searchedFixed_) +
-	                    capacityBytes(moved_) + capacityBytes(movers_) + overrides_.size() * (sizeof(Override) + 48);
-	for (const BlockCover& cover : covers_) {
-		bytes += capacityBytes(cover.shells) + capacityBytes(cover.vertexShells) + capacityBytes(cover.edgeShells) +
-		         capacityBytes(cover.faceShells) + capacityBytes(cover.linkedSets);
-		for (const Shell& shell : cover.shells) bytes += capacityBytes(shell.corners) + capacityBytes(shell.divisions);
-		for (const LinkedSet& set : cover.linkedSets)
-			bytes += capacityBytes(set.vertices) + capacityBytes(set.edges) + capacityBytes(set.faces);
-	}
+	                    capacityBytes(oversize_) + capacityBytes(shellFixed_) +
+	                    capacityBytes(pairStart_) + capacityBytes(pairNext_) + capacityBytes(hits_) +
+	                    capacityBytes(candidateSets_) + capacityBytes(linked_) + capacityBytes(linkedSets_) +
+	                    capacityBytes(lists_) + capacityBytes(listTable_) + capacityBytes(listScratch_) +
+	                    capacityBytes(searchBoxes_) + capacityBytes(cached_) + capacityBytes(kept_) +
+	                    capacityBytes(searchedFixed_) + capacityBytes(moved_) + capacityBytes(movers_) +
+	                    overrides_.size() * (sizeof(Override) + 48);
+	for (const std::vector<int>& list : lists_) bytes += capacityBytes(list);
 	return bytes;
 }
 

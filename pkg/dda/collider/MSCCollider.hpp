@@ -4,9 +4,11 @@
 // of the block gets one axis-aligned box, its *shell*: the box of the corners
 // in the slab and of the points where edges cross the slab's planes (the
 // paper's division points). Slices tile the block, so shells cover any convex
-// block exactly. Built once per block: division points as (edge, fraction),
-// and per vertex, edge and face the shells whose closed slab it touches (its
-// linked shells). DDA moves blocks by affine maps, which keep fractions and
+// block exactly. Built once per block: per vertex, edge and face the shells
+// whose closed slab it touches (its linked shells: consecutive slabs, kept as
+// a range), and per inner plane its division points as (edge, fraction),
+// kept once for the two slabs it bounds (a shell's corners are the vertices
+// linked to it). DDA moves blocks by affine maps, which keep fractions and
 // slab membership: the cover moves with the block, and each step only moving
 // blocks' boxes are recomputed. Shells widened by d0 are entered in the
 // cells of a uniform grid (the paper's subspaces) and compared within cells.
@@ -21,7 +23,8 @@
 // candidate when two of its shells overlap in both tests. Where the paper lets
 // the nearest shell decide, a pair here links the union of its overlapping
 // shells' sub-units, each once (lists built once per block and shell set,
-// shared by the pairs): every feature of its contacts while penetration stays
+// shared by the pairs, and kept once per content: blocks of one topology
+// share them): every feature of its contacts while penetration stays
 // below d0 / 2 (argued in the .cpp). The narrow phase (detectPairContacts with
 // the linked sets) loops over those only and searches a deeper pair again
 // with every sub-unit, so its contacts are exactly the full search's.
@@ -43,6 +46,7 @@
 #include <array>
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -84,8 +88,8 @@ public:
 	// (x log2(n)) re-searched one by one instead of a full grid search.
 	static constexpr double kVerletSkinFactor = 1.0;
 	static constexpr double kVerletPartialFactor = 4.0;
-	// Linked-set lists kept per block (one per shell set met); more are dropped
-	// at the next call.
+	// Linked sets kept per block (one per shell set met); when a block has
+	// more, every block's are dropped at the next call.
 	static constexpr std::size_t kMaxLinkedSetsPerBlock = 64;
 
 	// criticalLengthFactor > 0 [-], segments in [1, kMaxSegments]; InputError otherwise.
@@ -136,33 +140,53 @@ public:
 	void readState(StateReader& in, const std::vector<Block>& blocks) override;
 
 private:
+	// A sub-unit's linked shells: slabs first..last (an interval's slabs are
+	// consecutive), none when first > last.
+	struct ShellRange {
+		std::uint8_t first = 1, last = 0;
+		// The range of a mask of consecutive slabs.
+		static ShellRange of(std::uint64_t mask) {
+			ShellRange r;
+			for (int j = 0; j < kMaxSegments; ++j)
+				if (mask >> j & 1) {
+					if (r.first > r.last) r.first = static_cast<std::uint8_t>(j);
+					r.last = static_cast<std::uint8_t>(j);
+				}
+			return r;
+		}
+		bool contains(int j) const { return first <= j && j <= last; }
+		std::uint64_t mask() const {
+			return first > last ? 0 : (~std::uint64_t{0} >> (63 - last)) & (~std::uint64_t{0} << first);
+		}
+	};
+	// A point where edge {from, to} crosses a slab's plane.
 	struct DivisionPoint {
-		int edge;
-		double fraction;  // point = start + fraction x (end - start), in [0, 1]
-	};
-	struct Shell {
-		std::vector<int> corners;             // vertices inside the slab
-		std::vector<DivisionPoint> divisions;  // edges crossing the slab's planes
-	};
-	// The sub-units linked to a set of a block's shells.
-	struct LinkedSet {
-		std::uint64_t shells;
-		std::vector<int> vertices, edges, faces;
+		int from, to;
+		double fraction;  // point = from + fraction x (to - from), in [0, 1]
 	};
 	struct BlockCover {
-		const ConvexPolyhedron* shape = nullptr;  // the cover is rebuilt when it changes
+		// The cover is rebuilt when the block's shape changes (held: its
+		// address is not reused, and saving finds division points' edges in it).
+		std::shared_ptr<const ConvexPolyhedron> shape;
 		double criticalLength = 0;                // [m], as built
+		double widening = 0;                      // [m]: kShellWideningRelative x diagonal
 		int segments = 0;                         // as asked (used when the block is long)
 		int shellCount = 0;
-		int firstShell = 0;  // into the flat shell arrays
-		double widening = 0;  // [m]: kShellWideningRelative x diagonal
+		int firstShell = 0;    // into the flat shell arrays
+		int firstSubUnit = 0;  // into shellRanges_: its vertices, then edges, then faces
+		int vertexCount = 0, edgeCount = 0, faceCount = 0;
+		int linkedSets = -1;  // its newest set in linkedSets_ (a chain through next), -1: none
+		int linkedSetCount = 0;
+		std::array<int, 3> frameFaces{-1, -1, -1};
 		// Boxes and frame computed while the block was fixed (kept until it moves).
 		bool boxesBuilt = false;
-		std::array<int, 3> frameFaces{-1, -1, -1};
-		std::vector<Shell> shells;
-		// Bit s: linked to shell s (touches its slab).
-		std::vector<std::uint64_t> vertexShells, edgeShells, faceShells;
-		std::vector<LinkedSet> linkedSets;  // built on demand, not saved
+	};
+	// The sub-units linked to a set of a block's shells: indices into lists_
+	// of its vertices, edges and faces.
+	struct LinkedSet {
+		std::uint64_t shells;
+		int next;  // the block's previous set, -1: none
+		std::array<int, 3> lists;
 	};
 	// A block's frame at this step: rows of `axes` are unit face normals (or
 	// the coordinate axes), `dual` = axes^-1; a shell's extent is the range of
@@ -177,21 +201,17 @@ private:
 		double criticalLength;
 		int segments;
 	};
-	// A shell pair, as the block pair (a < b) and a shell of each (flat indices).
+	// A shell pair (flat indices): s of the pair's first block, t of the second.
 	struct ShellPair {
-		int a, b, s, t;
-		bool operator<(const ShellPair& o) const {
-			return a < o.a || (a == o.a && (b < o.b || (b == o.b && (s < o.s || (s == o.s && t < o.t)))));
-		}
-	};
-	// A candidate: the block pair and the shells of each that overlap.
-	struct Candidate {
-		int a, b;
-		std::uint64_t shellsA, shellsB;
-		int setA = -1, setB = -1;  // into the blocks' linkedSets
+		int s, t;
 	};
 
-	void buildCover(const Block& block, double criticalLength, int segments, BlockCover& cover) const;
+	// Appends the block's cover to shellRanges and divisions (divisionStart:
+	// one entry per shell).
+	void buildCover(const Block& block, double criticalLength, int segments, BlockCover& cover,
+	                std::vector<ShellRange>& shellRanges, std::vector<DivisionPoint>& divisions,
+	                std::vector<int>& divisionStart) const;
+	// Lays the covers' shells out in the flat arrays (after covers changed).
 	void layoutShells();
 	void updateBoxes(const Block& block, BlockCover& cover, Frame& frame);
 	// Grid search: every shell pair (different blocks, not both fixed) whose
@@ -203,10 +223,13 @@ private:
 	// elementwise, offset = a.axes x (b.origin - a.origin)).
 	bool apartInFrame(int s, int t, const Eigen::Matrix3d& m, const Eigen::Matrix3d& size, const Vector3& offset,
 	                  double limit) const;
-	// Sorts shell pairs in ShellPair order (counting sort on the first block).
+	// Sorts shell pairs by first block, then (t, s): by block pair.
 	void sortShellPairs(std::vector<ShellPair>& pairs, int blocks);
-	// Index into cover.linkedSets of the set for `shells` (built when new).
-	static int linkedSet(BlockCover& cover, std::uint64_t shells);
+	// Index into linkedSets_ of the block's set for `shells` (built when new).
+	int linkedSet(int block, std::uint64_t shells);
+	// Index into lists_ of a list equal to `list` (added when new).
+	int internList(const std::vector<int>& list);
+	void clearLinkedSets();
 
 	double criticalLengthFactor_;
 	double criticalLength_ = 0;
@@ -214,33 +237,48 @@ private:
 	std::map<int, Override> overrides_;
 	bool coverChanged_ = false;
 	std::vector<BlockCover> covers_;
+	// The covers' parts, block after block. Per sub-unit its linked shells.
+	// Per flat shell, divisionStart_ is where the division points on its
+	// lower plane start in divisions_ (none on a block's first shell's);
+	// a shell's points are its corners (the vertices linked to it) and
+	// divisions_[divisionStart_[s], divisionStart_[s + 2]): the points on its
+	// lower plane, then on its upper one (kept once per plane; two end entries).
+	std::vector<ShellRange> shellRanges_;
+	std::vector<DivisionPoint> divisions_;
+	std::vector<int> divisionStart_;
 	std::vector<Frame> frames_;               // per block
 	std::vector<Eigen::AlignedBox3d> boxes_;  // per flat shell, not widened
 	std::vector<Vector3> extentLow_, extentHigh_;  // per flat shell, in its block's frame [m]
-	// Every shell's points, flat (shell s: [pointStart_[s], pointStart_[s + 1])):
-	// a corner is (v, v, 0), a division point (edge start, edge end, fraction).
-	struct ShellPoint {
-		int from, to;
-		double fraction;
-	};
-	std::vector<ShellPoint> points_;
-	std::vector<int> pointStart_;
-	std::vector<int> shellBlock_, shellIndex_;  // per flat shell
+	std::vector<int> shellBlock_;                  // per flat shell
 	std::vector<Eigen::AlignedBox3d> widened_;
-	using Cell = Eigen::Array<long, 3, 1>;  // a subspace's integer coordinates
-	std::vector<Cell> cellLow_, cellHigh_;   // per flat shell: the cells its box spans
+	using Cell = Eigen::Array<int, 3, 1>;   // a subspace's integer coordinates
+	// Per flat shell the cells its box spans: from cellLow_ on, span more per
+	// axis (at most kMaxCellsPerShell - 1), unless it is oversize.
+	struct CellSpan {
+		std::uint8_t x, y, z;
+		bool oversize;
+	};
+	std::vector<Cell> cellLow_;
+	std::vector<CellSpan> cellSpan_;
 	std::vector<std::pair<std::uint64_t, int>> cellEntries_;  // sparse keys: (cell key, shell), sorted
 	std::vector<int> cellShells_;             // every cell's shells, cell after cell
 	std::vector<std::uint32_t> cellStart_;    // dense keys: where each cell's shells start
 	bool denseGrid_ = false;
 	std::vector<int> oversize_;   // shells compared with every shell
-	std::vector<char> isOversize_, shellFixed_;
-	std::vector<std::size_t> pairStart_;  // sortShellPairs' counts
-	std::vector<ShellPair> sortedPairs_;
-	std::vector<ShellPair> hits_;
-	std::vector<Candidate> candidates_;
+	std::vector<char> shellFixed_;
+	std::vector<std::size_t> pairStart_, pairNext_;  // sortShellPairs' buckets
+	std::vector<ShellPair> hits_;  // without the cache: the shell pairs whose d0-boxes meet, sorted
+	// Per candidate its two linked sets, until linked_ is filled.
+	std::vector<std::array<int, 2>> candidateSets_;
 	std::vector<LinkedSubUnits> linked_;  // the first linkedCount_ are valid
 	int linkedCount_ = 0;
+	// Linked sets of every block, and the distinct sub-unit lists they use
+	// (blocks of one topology share them), found by hashing their contents
+	// (listTable_: open addressing, -1 = free).
+	std::vector<LinkedSet> linkedSets_;
+	std::vector<std::vector<int>> lists_;
+	std::vector<int> listTable_, listScratch_;
+	bool linkedSetsOverflow_ = false;  // a block has more than kMaxLinkedSetsPerBlock
 	long totalShellUpdates_ = 0;
 	long coverBuilds_ = 0;
 	// The cache: each shell's D-box from its block's last search, every shell
