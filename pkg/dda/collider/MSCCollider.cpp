@@ -57,7 +57,7 @@ struct ShellBounds {
 		min = low = Vector3::Constant(std::numeric_limits<double>::infinity());
 		max = high = -min;
 	}
-	void add(const Vector3& p, const Vector3& c) {
+	[[gnu::always_inline]] void add(const Vector3& p, const Vector3& c) {
 		min = min.cwiseMin(p);
 		max = max.cwiseMax(p);
 		low = low.cwiseMin(c);
@@ -77,7 +77,7 @@ void resizeWithHeadroom(std::vector<T>& v, std::size_t n) {
 // Appends x, the capacity growing by 1/8 when full (not doubling: the arrays
 // so filled are kept from call to call at their largest size).
 template <class T>
-void pushWithHeadroom(std::vector<T>& v, const T& x) {
+[[gnu::always_inline]] inline void pushWithHeadroom(std::vector<T>& v, const T& x) {
 	if (v.size() == v.capacity()) v.reserve(v.size() + v.size() / 8 + 64);
 	v.push_back(x);
 }
@@ -589,8 +589,7 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 		return Eigen::AlignedBox3d(boxes_[s].min() - w, boxes_[s].max() + w);
 	};
 
-	// Shell pairs whose d0-boxes meet, sorted: hits_, or those of cached_
-	// whose d0-boxes meet (tested below).
+	// Shell pairs whose d0-boxes meet, sorted.
 	hits_.clear();
 	if (!reuse_) {
 		cacheValid_ = false;
@@ -657,44 +656,31 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 				stats.pairsReused = static_cast<long>(cached_.size());
 			}
 		}
+		for (const ShellPair& p : cached_)
+			if (widened_[p.s].intersects(widened_[p.t])) pushWithHeadroom(hits_, p);
+		stats.shellTests += static_cast<long>(cached_.size());
 	}
 
 	// Per block pair: the shell pairs that also overlap in both frames, and
 	// the union of their shells; a candidate links the union's sub-units
 	// (lists shared per block and shell set).
-	const std::vector<ShellPair>& tested = reuse_ ? cached_ : hits_;
 	candidateSets_.clear();
-	for (std::size_t h = 0; h < tested.size();) {
-		const int a = shellBlock_[tested[h].s], b = shellBlock_[tested[h].t];
+	for (std::size_t h = 0; h < hits_.size();) {
+		const int a = shellBlock_[hits_[h].s], b = shellBlock_[hits_[h].t];
 		std::size_t end = h + 1;
-		while (end < tested.size() && shellBlock_[tested[end].s] == a && shellBlock_[tested[end].t] == b) ++end;
-		// The frames' terms, when a shell pair's d0-boxes meet.
-		bool framed = false;
-		Eigen::Matrix3d inA, inB, sizeInA, sizeInB;
-		Vector3 offsetInA, offsetInB;
-		double limit = 0;
+		while (end < hits_.size() && shellBlock_[hits_[end].s] == a && shellBlock_[hits_[end].t] == b) ++end;
+		const Frame& fa = frames_[a];
+		const Frame& fb = frames_[b];
+		const Vector3 between = fb.origin - fa.origin;
+		const Eigen::Matrix3d inA = fa.axes * fb.dual, inB = fb.axes * fa.dual;
+		const Eigen::Matrix3d sizeInA = inA.cwiseAbs(), sizeInB = inB.cwiseAbs();
+		const Vector3 offsetInA = fa.axes * between, offsetInB = fb.axes * (-between);
+		const double roundoff =
+		    kFrameRoundoffRelative * (between.cwiseAbs().sum() + 10 * (fa.reach + fb.reach));
+		const double limit = 2 * margin + covers_[a].widening + covers_[b].widening + roundoff;
 		std::uint64_t shellsA = 0, shellsB = 0;
 		for (; h < end; ++h) {
-			const int s = tested[h].s, t = tested[h].t;
-			if (reuse_) {
-				++stats.shellTests;
-				if (!widened_[s].intersects(widened_[t])) continue;
-			}
-			if (!framed) {
-				const Frame& fa = frames_[a];
-				const Frame& fb = frames_[b];
-				const Vector3 between = fb.origin - fa.origin;
-				inA = fa.axes * fb.dual;
-				inB = fb.axes * fa.dual;
-				sizeInA = inA.cwiseAbs();
-				sizeInB = inB.cwiseAbs();
-				offsetInA = fa.axes * between;
-				offsetInB = fb.axes * (-between);
-				const double roundoff =
-				    kFrameRoundoffRelative * (between.cwiseAbs().sum() + 10 * (fa.reach + fb.reach));
-				limit = 2 * margin + covers_[a].widening + covers_[b].widening + roundoff;
-				framed = true;
-			}
+			const int s = hits_[h].s, t = hits_[h].t;
 			++stats.shellTests;
 			if (apartInFrame(s, t, inA, sizeInA, offsetInA, limit) || apartInFrame(t, s, inB, sizeInB, offsetInB, limit))
 				continue;

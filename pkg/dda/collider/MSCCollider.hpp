@@ -267,7 +267,7 @@ private:
 	std::vector<int> oversize_;   // shells compared with every shell
 	std::vector<char> shellFixed_;
 	std::vector<std::size_t> pairStart_, pairNext_;  // sortShellPairs' buckets
-	std::vector<ShellPair> hits_;  // without the cache: the shell pairs whose d0-boxes meet, sorted
+	std::vector<ShellPair> hits_;  // the shell pairs whose d0-boxes meet, sorted
 	// Per candidate its two linked sets, until linked_ is filled.
 	std::vector<std::array<int, 2>> candidateSets_;
 	std::vector<LinkedSubUnits> linked_;  // the first linkedCount_ are valid
