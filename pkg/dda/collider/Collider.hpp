@@ -8,6 +8,7 @@
 
 #include "dda/block/Block.hpp"
 #include "dda/contact/SubUnits.hpp"
+#include "dda/util/CapacityBytes.hpp"
 
 #include <Eigen/Geometry>
 
@@ -69,12 +70,6 @@ public:
 	// boxes, shells, grid, caches, linked lists) [bytes], for stats().
 	virtual std::size_t memoryBytes() const { return 0; }
 };
-
-// Heap bytes of a vector's storage (its capacity) [bytes].
-template <class T>
-std::size_t capacityBytes(const std::vector<T>& v) {
-	return v.capacity() * sizeof(T);
-}
 
 // Every pair of blocks that are not both fixed: O(n^2), the reference.
 class AllPairsCollider : public Collider {

@@ -1,5 +1,7 @@
 #include "Contact.hpp"
 
+#include "dda/util/CapacityBytes.hpp"
+
 #include <algorithm>
 
 namespace dda {
@@ -15,11 +17,6 @@ bool facesAdjacent(const ConvexPolyhedron& shape, int f, int g) {
 	for (const auto& faces : shape.edgeFaces)
 		if ((faces[0] == f && faces[1] == g) || (faces[0] == g && faces[1] == f)) return true;
 	return false;
-}
-
-template <class T>
-std::size_t capacityBytes(const std::vector<T>& v) {
-	return v.capacity() * sizeof(T);
 }
 
 // Same blocks, kind and first feature (the second is not compared).
@@ -65,23 +62,13 @@ void ContactStore::beginStep() {
 	// keys in descending order, each becoming its chain's head, so chains
 	// ascend.
 	for (int k = 0; k < n; ++k) {
-		const ContactKey& key = previous_[k].key;
-		for (std::size_t h = ContactKeyHash{}(key) & previousIndex_.mask;; h = (h + 1) & previousIndex_.mask) {
-			int& slot = previousIndex_.slots[h];
-			if (slot < 0) slot = k;
-			if (previous_[slot].key == key) break;
-		}
+		int& slot = previousIndex_.slots[slotOf(previousIndex_, previous_[k].key, false)];
+		if (slot < 0) slot = k;
 	}
 	for (int k = n - 1; k >= 0; --k) {
-		ContactKey partial = previous_[k].key;
-		partial.feature2 = -1;
-		for (std::size_t h = ContactKeyHash{}(partial) & byFeature1_.mask;; h = (h + 1) & byFeature1_.mask) {
-			int& slot = byFeature1_.slots[h];
-			if (slot >= 0 && !sameFeature1(previous_[slot].key, partial)) continue;
-			sameFeature1_[k] = slot;
-			slot = k;
-			break;
-		}
+		int& slot = byFeature1_.slots[slotOf(byFeature1_, previous_[k].key, true)];
+		sameFeature1_[k] = slot;
+		slot = k;
 	}
 	claimed_.assign(previous_.size(), 0);
 	if (!entrancesSorted_) normalize(entrances_);
@@ -90,19 +77,20 @@ void ContactStore::beginStep() {
 	entrancesSorted_ = true;
 }
 
-int ContactStore::previousIndex(const ContactKey& key) const {
-	for (std::size_t h = ContactKeyHash{}(key) & previousIndex_.mask;; h = (h + 1) & previousIndex_.mask) {
-		const int slot = previousIndex_.slots[h];
-		if (slot < 0 || previous_[slot].key == key) return slot;
+std::size_t ContactStore::slotOf(const FlatIndex& index, ContactKey key, bool byFeature1) const {
+	if (byFeature1) key.feature2 = -1;
+	for (std::size_t h = ContactKeyHash{}(key) & index.mask;; h = (h + 1) & index.mask) {
+		const int k = index.slots[h];
+		if (k < 0 || (byFeature1 ? sameFeature1(previous_[k].key, key) : previous_[k].key == key)) return h;
 	}
 }
 
-int ContactStore::firstWithFeature1(ContactKey partial) const {
-	partial.feature2 = -1;
-	for (std::size_t h = ContactKeyHash{}(partial) & byFeature1_.mask;; h = (h + 1) & byFeature1_.mask) {
-		const int slot = byFeature1_.slots[h];
-		if (slot < 0 || sameFeature1(previous_[slot].key, partial)) return slot;
-	}
+int ContactStore::previousIndex(const ContactKey& key) const {
+	return previousIndex_.slots[slotOf(previousIndex_, key, false)];
+}
+
+int ContactStore::firstWithFeature1(const ContactKey& key) const {
+	return byFeature1_.slots[slotOf(byFeature1_, key, true)];
 }
 
 Contact& ContactStore::add(const ContactKey& key, ContactType pairType, const SubContact& geometry,

@@ -119,10 +119,14 @@ private:
 		std::size_t mask = 0;
 		void reset(std::size_t entries);
 	};
+	// The slot of `index` for key (byFeature1: for its blocks, kind and
+	// feature1): the one holding a matching previous contact, else the empty
+	// slot where it would go.
+	std::size_t slotOf(const FlatIndex& index, ContactKey key, bool byFeature1) const;
 	// Index into previous_ of the contact with this key, or -1.
 	int previousIndex(const ContactKey& key) const;
 	// The first previous contact with key's blocks, kind and feature1, or -1.
-	int firstWithFeature1(ContactKey key) const;
+	int firstWithFeature1(const ContactKey& key) const;
 	// Sorts entrances by key, keeping the last one set per key.
 	static void normalize(std::vector<std::pair<std::uint64_t, EntranceFeature>>& entrances);
 

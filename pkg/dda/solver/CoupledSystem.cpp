@@ -1,5 +1,7 @@
 #include "CoupledSystem.hpp"
 
+#include "dda/util/CapacityBytes.hpp"
+
 #include <Eigen/Cholesky>
 #include <Eigen/OrderingMethods>
 #include <Eigen/SparseCholesky>
@@ -110,9 +112,9 @@ int CoupledSystem::largestComponent() const {
 }
 
 std::size_t CoupledSystem::memoryBytes() const {
-	const auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
-	return bytes(slot_) + bytes(members_) + bytes(unknowns_) + bytes(componentStart_) + bytes(diagonal_) +
-	       bytes(force_) + bytes(linkSlots_) + bytes(linkStart_) + bytes(offDiagonal_);
+	return capacityBytes(slot_) + capacityBytes(members_) + capacityBytes(unknowns_) + capacityBytes(componentStart_) +
+	       capacityBytes(diagonal_) + capacityBytes(force_) + capacityBytes(linkSlots_) + capacityBytes(linkStart_) +
+	       capacityBytes(offDiagonal_);
 }
 
 void CoupledSystem::solve(std::vector<Vector12>& solutions, int threadsFrom) {
