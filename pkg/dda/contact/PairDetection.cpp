@@ -569,26 +569,54 @@ std::optional<SubContact> edgeEdgeContact(bool firstIsA, const Prepared& blockI,
 	const Vector3& p3 = blockJ.edgeStart(e2);
 	const Vector3& p4 = blockJ.edgeEnd(e2);
 	const Vector3 da = p2 - p1, db = p4 - p3;
-	const double la = da.norm(), lb = db.norm();
 	const Vector3 cross = da.cross(db);
+	// The closest points of the two lines must lie strictly inside both
+	// segments (checked last below, on edgeEdgeDistance's s and t). Most edge
+	// pairs fail that, so it is checked first, on the line parameters
+	// edgeEdgeDistance computes by these same expressions: for edges that are
+	// not parallel its s, t are these when both lie in [0, 1], and otherwise a
+	// value clamped to 0 or 1, which the endpoint test rejects
+	// (lengthTolerance > 0). The same pairs are rejected, only sooner.
+	// Every test below only rejects, so their order changes no result.
+	const Vector3 w = p3 - p1;
+	const double sNumerator = w.cross(db).dot(cross), tNumerator = w.cross(da).dot(cross);
+	{
+		// First without a square root: sLine = sNumerator / nn with nn > 0
+		// (nn = 0 gives no rejection here), so a negative numerator gives a
+		// negative sLine, or -0 for an underflow, which the endpoint test
+		// rejects; and nn is cross.squaredNorm() to within a few DBL_EPSILON
+		// (|cross| rounded, then squared), so a numerator above
+		// (1 + 1e-12) squaredNorm gives sLine > 1.
+		const double bound = (1 + 1e-12) * cross.squaredNorm();
+		if (sNumerator < 0 || tNumerator < 0 || sNumerator > bound || tNumerator > bound) return std::nullopt;
+	}
+	const double la = da.norm(), lb = db.norm();
 	const double crossNorm = cross.norm();
 	if (parallelDirections(da, db, cross, crossNorm, la, lb, sinTolerance)) return std::nullopt;
 	const double tol = settings.lengthTolerance;
 	{
-		// The closest points of the two lines must lie strictly inside both
-		// segments (checked last below, on edgeEdgeDistance's s and t). Most
-		// edge pairs fail that, so it is checked first, on the line parameters
-		// edgeEdgeDistance computes by these same expressions: for edges that
-		// are not parallel its s, t are these when both lie in [0, 1], and
-		// otherwise a value clamped to 0 or 1, which the endpoint test rejects
-		// (lengthTolerance > 0). The same pairs are rejected, only sooner.
-		const Vector3 w = p3 - p1;
 		const double nn = crossNorm * crossNorm;
-		const double sLine = w.cross(db).dot(cross) / nn;
-		const double tLine = w.cross(da).dot(cross) / nn;
+		const double sLine = sNumerator / nn;
+		const double tLine = tNumerator / nn;
 		if (!(sLine >= 0 && sLine <= 1 && tLine >= 0 && tLine <= 1)) return std::nullopt;
 		if (sLine * la <= tol || (1 - sLine) * la <= tol || tLine * lb <= tol || (1 - tLine) * lb <= tol)
 			return std::nullopt;
+	}
+	{
+		// The gap limits, on the distance of the two lines before the stencil:
+		// the stencil's |gap| is |Delta| / S with S = crossNorm (the same
+		// expression) and Delta = da . (w x (p4 - p1)), whose exact value is
+		// -w . cross. Each of the two triple products is within 10
+		// DBL_EPSILON x (the product of its factors' lengths) of its exact
+		// value; `margin` bounds both errors, with 1-norms for lengths and
+		// 1e-12 for 10 DBL_EPSILON (a factor of ~450 to spare), so a line
+		// distance above a limit's magnitude by more than it means a gap
+		// outside that limit.
+		const auto norm1 = [](const Vector3& v) { return std::abs(v.x()) + std::abs(v.y()) + std::abs(v.z()); };
+		const double w1 = norm1(w);
+		const double margin = 1e-12 * norm1(da) * w1 * (w1 + 2 * norm1(db)) / crossNorm;
+		const double lineGap = std::abs(w.dot(cross)) / crossNorm;
+		if (lineGap - margin > std::max(limits.highestGap, -limits.deepestGap)) return std::nullopt;
 	}
 	// From block i towards block j: out of i at its edge, into j at its edge.
 	const Vector3 reference = blockI.edgeOutward(e1) - blockJ.edgeOutward(e2);
@@ -780,13 +808,26 @@ struct Feature {
 
 // The smallest feature of `block` within `tolerance` [m] of all the points: one
 // corner, else one edge, else a face.
+//
+// Most corners and edges are far from the points; a coordinate difference
+// rejects them without a square root. The rejections are those of the
+// distances themselves: a computed norm is at least any |component| of its
+// vector to within 2 DBL_EPSILON relative, and a computed segment distance is
+// at least x's distance from the segment's bounding box along an axis, to
+// within a few DBL_EPSILON of the coordinates (the closest point is rounded);
+// the margins 1e-12 cover both.
 Feature featureOf(const Prepared& block, const std::vector<Vector3>& points, double tolerance) {
 	Feature out;
 	if (points.empty()) return out;
+	const double reach = tolerance * (1 + 1e-12);
 	double bestCorner = std::numeric_limits<double>::infinity();
 	for (int v = 0; v < block.cornerCount(); ++v) {
+		const Vector3& c = block.corner(v);
+		bool far = false;
+		for (const Vector3& x : points) far = far || (x - c).cwiseAbs().maxCoeff() > reach;
+		if (far) continue;
 		double worst = 0;
-		for (const Vector3& x : points) worst = std::max(worst, (x - block.corner(v)).norm());
+		for (const Vector3& x : points) worst = std::max(worst, (x - c).norm());
 		if (worst <= tolerance && worst < bestCorner) {
 			bestCorner = worst;
 			out = {FeatureKind::Vertex, v};
@@ -795,8 +836,19 @@ Feature featureOf(const Prepared& block, const std::vector<Vector3>& points, dou
 	if (out.kind == FeatureKind::Vertex) return out;
 	double bestEdge = std::numeric_limits<double>::infinity();
 	for (int e = 0; e < block.edgeCount(); ++e) {
+		const Vector3& p = block.edgeStart(e);
+		const Vector3& q = block.edgeEnd(e);
+		const Vector3 lower = p.cwiseMin(q), upper = p.cwiseMax(q);
+		bool far = false;
+		for (const Vector3& x : points) {
+			for (int k = 0; k < 3 && !far; ++k) {
+				const double margin = reach + 1e-12 * (std::abs(x[k]) + std::abs(p[k]) + std::abs(q[k]));
+				far = x[k] - upper[k] > margin || lower[k] - x[k] > margin;
+			}
+		}
+		if (far) continue;
 		double worst = 0;
-		for (const Vector3& x : points) worst = std::max(worst, segmentDistance(x, block.edgeStart(e), block.edgeEnd(e)));
+		for (const Vector3& x : points) worst = std::max(worst, segmentDistance(x, p, q));
 		if (worst <= tolerance && worst < bestEdge) {
 			bestEdge = worst;
 			out = {FeatureKind::Edge, e};
