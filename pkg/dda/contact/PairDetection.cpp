@@ -834,18 +834,19 @@ Feature featureOf(const Prepared& block, const std::vector<Vector3>& points, dou
 		}
 	}
 	if (out.kind == FeatureKind::Vertex) return out;
+	// The largest coordinate magnitude of the points and corners bounds the
+	// rounding of a closest point's coordinates (and of the box's bounds).
+	double largest = 0;
+	for (const Vector3& x : points) largest = std::max(largest, x.cwiseAbs().maxCoeff());
+	for (int v = 0; v < block.cornerCount(); ++v) largest = std::max(largest, block.corner(v).cwiseAbs().maxCoeff());
+	const double margin = reach + 3e-12 * largest;
 	double bestEdge = std::numeric_limits<double>::infinity();
 	for (int e = 0; e < block.edgeCount(); ++e) {
 		const Vector3& p = block.edgeStart(e);
 		const Vector3& q = block.edgeEnd(e);
-		const Vector3 lower = p.cwiseMin(q), upper = p.cwiseMax(q);
+		const Vector3 lower = p.cwiseMin(q).array() - margin, upper = p.cwiseMax(q).array() + margin;
 		bool far = false;
-		for (const Vector3& x : points) {
-			for (int k = 0; k < 3 && !far; ++k) {
-				const double margin = reach + 1e-12 * (std::abs(x[k]) + std::abs(p[k]) + std::abs(q[k]));
-				far = x[k] - upper[k] > margin || lower[k] - x[k] > margin;
-			}
-		}
+		for (const Vector3& x : points) far = far || (x.array() > upper.array()).any() || (x.array() < lower.array()).any();
 		if (far) continue;
 		double worst = 0;
 		for (const Vector3& x : points) worst = std::max(worst, segmentDistance(x, p, q));
