@@ -958,9 +958,20 @@ const char* contactTypeName(ContactType type) {
 	return "?";
 }
 
-std::optional<PairContacts> detectPairContacts(const BlockGeometry& blockA, const BlockGeometry& blockB,
-                                               const DetectionSettings& settings, const EntranceFeature& previous,
-                                               const LinkedSubUnits* linked, NarrowPhaseWork* work) {
+namespace {
+// What detectInto returns: its early outs return std::nullopt (no contact),
+// as when it returned std::optional<PairContacts>; its end returns true.
+struct Detected {
+	bool found;
+	Detected(std::nullopt_t) : found(false) {}
+	Detected(bool value) : found(value) {}
+};
+}  // namespace
+
+// The bool form of detectPairContacts (the header's two forms call it).
+static Detected detectInto(const BlockGeometry& blockA, const BlockGeometry& blockB, const DetectionSettings& settings,
+                           PairContacts& out, const EntranceFeature& previous, const LinkedSubUnits* linked,
+                           NarrowPhaseWork* work) {
 	const double d0 = settings.contactDistance, tol = settings.lengthTolerance;
 	NarrowPhaseWork ownWork;
 	if (!work) work = &ownWork;
@@ -1062,7 +1073,7 @@ std::optional<PairContacts> detectPairContacts(const BlockGeometry& blockA, cons
 	// the pair to the full search.
 	if (linked && !(deepestBound >= -0.5 * d0)) {
 		++work->fullSearches;
-		return detectPairContacts(blockA, blockB, settings, previous, nullptr, work);
+		return detectPairContacts(blockA, blockB, settings, out, previous, nullptr, work);
 	}
 
 	// 2. The entrance feature.
@@ -1096,12 +1107,13 @@ std::optional<PairContacts> detectPairContacts(const BlockGeometry& blockA, cons
 	// search: both go to the full search too.
 	if (linked && (!(separation >= -0.5 * d0) || !previousLinked(a, b, previous))) {
 		++work->fullSearches;
-		return detectPairContacts(blockA, blockB, settings, previous, nullptr, work);
+		return detectPairContacts(blockA, blockB, settings, out, previous, nullptr, work);
 	}
 
-	// 3. Sub-contacts.
-	PairContacts out;
-	out.contacts.reserve(8);
+	// 3. Sub-contacts, into `out` as into a new PairContacts, but `contacts`
+	// keeps its capacity (World reuses its results from chunk to chunk).
+	out.normal = Vector3::UnitZ();  // the default, kept when no entrance sets it
+	out.contacts.clear();
 	if (entrance.kind == EntranceFeature::EdgePair) {
 		std::optional<SubContact> c =
 		    edgeEdgeContact(true, a, entrance.feature, b, entrance.other, settings, sinTolerance);
@@ -1142,9 +1154,20 @@ std::optional<PairContacts> detectPairContacts(const BlockGeometry& blockA, cons
 	}
 	out.type = structuralType(a, featureOf(a, pointsA, featureTolerance), b, featureOf(b, pointsB, featureTolerance),
 	                          sinTolerance);
-	// The result is kept until the next step's detection: no spare slots
-	// (most pairs have one or two sub-contacts of the eight reserved).
-	out.contacts.shrink_to_fit();
+	return true;
+}
+
+bool detectPairContacts(const BlockGeometry& blockA, const BlockGeometry& blockB, const DetectionSettings& settings,
+                        PairContacts& out, const EntranceFeature& previous, const LinkedSubUnits* linked,
+                        NarrowPhaseWork* work) {
+	return detectInto(blockA, blockB, settings, out, previous, linked, work).found;
+}
+
+std::optional<PairContacts> detectPairContacts(const BlockGeometry& blockA, const BlockGeometry& blockB,
+                                               const DetectionSettings& settings, const EntranceFeature& previous,
+                                               const LinkedSubUnits* linked, NarrowPhaseWork* work) {
+	PairContacts out;
+	if (!detectPairContacts(blockA, blockB, settings, out, previous, linked, work)) return std::nullopt;
 	return out;
 }
 

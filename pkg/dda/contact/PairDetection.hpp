@@ -237,5 +237,13 @@ std::optional<PairContacts> detectPairContacts(const BlockGeometry& a, const Blo
                                                const DetectionSettings& settings,
                                                const EntranceFeature& previous = {},
                                                const LinkedSubUnits* linked = nullptr, NarrowPhaseWork* work = nullptr);
+// The same into `out`: true with every field of `out` set as the form above
+// returns it, false (`out` unspecified) when the blocks are farther apart.
+// `out.contacts` is cleared, not reallocated: a caller that reuses its
+// PairContacts (World, from pair to pair) allocates only when a pair has more
+// sub-contacts than its vector ever held.
+bool detectPairContacts(const BlockGeometry& a, const BlockGeometry& b, const DetectionSettings& settings,
+                        PairContacts& out, const EntranceFeature& previous = {}, const LinkedSubUnits* linked = nullptr,
+                        NarrowPhaseWork* work = nullptr);
 
 }  // namespace dda

@@ -55,11 +55,12 @@ public:
 	// Heap held now [bytes] (computed when asked, not every step): the broad
 	// phase's arrays (Collider::memoryBytes), the contact store (with the last
 	// step's contacts kept for their history), and the narrow phase's work
-	// arrays (per-block planes, per-pair results). Between steps they are
-	// what the last detection left. The solver's: the per-step arrays of the
-	// moving blocks (solutions, motions, the own systems of the blocks with
-	// springs) and the coupled system (CoupledSystem::memoryBytes), as the
-	// last step left them.
+	// arrays (per block: diagonal, planes entry, last chunk; the candidate
+	// pairs; the planes entries and pooled pair results, sized by a chunk of
+	// pairs). Between steps they are what the last detection left. The
+	// solver's: the per-step arrays of the moving blocks (solutions, motions,
+	// the own systems of the blocks with springs) and the coupled system
+	// (CoupledSystem::memoryBytes), as the last step left them.
 	struct MemoryUse {
 		std::size_t collider = 0, contacts = 0, narrowPhase = 0, solver = 0;
 	};
@@ -112,17 +113,28 @@ private:
 	CoupledSystem coupled_;
 	long openCloseFailures_ = 0;
 	std::vector<std::pair<int, int>> pairs_;
-	std::vector<std::optional<PairContacts>> pairResults_;
-	std::vector<NarrowPhaseWork> pairWork_;  // per candidate pair
+	// The narrow phase runs the candidate pairs in chunks (kPairChunk in
+	// World.cpp), so what it holds is sized by a chunk, not by the scene.
+	// Per pair of the current chunk, its result (a pool: each entry keeps its
+	// contacts' capacity from chunk to chunk and step to step, so detection
+	// allocates only while it grows), whether it is in contact, and its work.
+	std::vector<PairContacts> pairResults_;
+	std::vector<char> pairFound_;
+	std::vector<NarrowPhaseWork> pairWork_;
 	std::vector<int> movingIndex_;  // block -> index in moving_, -1 for fixed blocks
 	std::vector<BlockMotion> motions_;
 	std::vector<double> diagonals_;  // per block, bounding-box diagonal of this step [m]
-	// Per block, its face planes, edge data and bounding box for this step's
-	// detection (BlockPlanes), built before the parallel pair loop for the
-	// blocks of a candidate pair (planeBlocks_); read-only during the loop.
+	// Entries for the face planes, edge data and bounding box (BlockPlanes) of
+	// the blocks of the current chunk's pairs: a block's are built before the
+	// parallel pair loop of the first chunk with a pair of it (planeBlocks_
+	// lists those of this chunk), read-only in the loops, and its entry goes
+	// back to freePlanes_ after its last chunk (lastChunk_). planes_ is only
+	// grown, so its entries keep their vectors' capacity.
 	std::vector<BlockPlanes> planes_;
-	std::vector<char> inPair_;
+	std::vector<int> freePlanes_;
 	std::vector<int> planeBlocks_;
+	std::vector<int> planeSlot_;  // per block: its entry of planes_, -1 when none
+	std::vector<int> lastChunk_;  // per block: the last chunk with a pair of it (this step)
 	// Faces of fixed blocks covered by a flush neighbour (BlockGeometry::internalFaces).
 	std::vector<std::vector<char>> internalFaces_;
 	int internalFacesBlocks_ = -1;  // block count when internalFaces_ was computed
