@@ -42,11 +42,16 @@ void checkCover(double criticalLength, int segments, const std::string& what) {
 // The block's size [m]: its creation size, else the cube root of its volume.
 double blockSize(const Block& block) { return block.size > 0 ? block.size : std::cbrt(block.volume); }
 
-// A face's unit normal from its vector area (zero for a degenerate face).
-Vector3 faceNormal(const std::vector<int>& face, const std::vector<Vector3>& x) {
+// A face's unit normal from its vector area (zero for a degenerate face):
+// the face's corners are face[0, n).
+template <class Index>
+Vector3 faceNormal(const Index* face, std::size_t n, const std::vector<Vector3>& x) {
 	Vector3 area = Vector3::Zero();
-	for (std::size_t k = 1; k + 1 < face.size(); ++k) area += (x[face[k]] - x[face[0]]).cross(x[face[k + 1]] - x[face[0]]);
+	for (std::size_t k = 1; k + 1 < n; ++k) area += (x[face[k]] - x[face[0]]).cross(x[face[k + 1]] - x[face[0]]);
 	return area.normalized();
+}
+Vector3 faceNormal(const std::vector<int>& face, const std::vector<Vector3>& x) {
+	return faceNormal(face.data(), face.size(), x);
 }
 
 // A shell's box (min, max) and extent in its block's frame (low, high) as
@@ -185,6 +190,7 @@ void MSCCollider::buildCover(const Block& block, double criticalLength, int segm
 		const int f3 = best([&](const Vector3& n) { return std::abs(n.dot(across)); }, f1);
 		if (f3 >= 0 && std::abs(normals[f3].dot(across)) >= kMinFrameDeterminant) cover.frameFaces = {f1, f2, f3};
 	}
+	copyFrameCorners(shape, cover);
 	if (k == 1) {
 		shellRanges.insert(shellRanges.end(), nv + ne + nf, ShellRange::of(1));
 		divisionStart.push_back(static_cast<int>(divisions.size()));
@@ -233,6 +239,19 @@ void MSCCollider::buildCover(const Block& block, double criticalLength, int segm
 	}
 }
 
+void MSCCollider::copyFrameCorners(const ConvexPolyhedron& shape, BlockCover& cover) {
+	cover.frameCorners.fill(0);
+	if (cover.frameFaces[0] < 0 || shape.vertices.size() > 256) return;
+	std::size_t used = 0;
+	for (const int f : cover.frameFaces) used += 1 + shape.faces[f].size();
+	if (used > cover.frameCorners.size()) return;
+	std::uint8_t* out = cover.frameCorners.data();
+	for (const int f : cover.frameFaces) {
+		*out++ = static_cast<std::uint8_t>(shape.faces[f].size());
+		for (const int v : shape.faces[f]) *out++ = static_cast<std::uint8_t>(v);
+	}
+}
+
 void MSCCollider::updateBoxes(const Block& block, BlockCover& cover, Frame& frame) {
 	const ConvexPolyhedron& shape = *block.shape;
 	const std::vector<Vector3>& x = block.vertices;
@@ -240,7 +259,13 @@ void MSCCollider::updateBoxes(const Block& block, BlockCover& cover, Frame& fram
 	frame.axes.setIdentity();
 	if (cover.frameFaces[0] >= 0) {
 		Eigen::Matrix3d axes;
-		for (int j = 0; j < 3; ++j) axes.row(j) = faceNormal(shape.faces[cover.frameFaces[j]], x).transpose();
+		if (cover.frameCorners[0] > 0) {
+			const std::uint8_t* corners = cover.frameCorners.data();
+			for (int j = 0; j < 3; corners += 1 + corners[0], ++j)
+				axes.row(j) = faceNormal(corners + 1, corners[0], x).transpose();
+		} else {
+			for (int j = 0; j < 3; ++j) axes.row(j) = faceNormal(shape.faces[cover.frameFaces[j]], x).transpose();
+		}
 		if (std::abs(axes.determinant()) >= 0.5 * kMinFrameDeterminant) frame.axes = axes;
 	}
 	frame.dual = frame.axes.inverse();

@@ -178,6 +178,12 @@ private:
 		int linkedSets = -1;  // its newest set in linkedSets_ (a chain through next), -1: none
 		int linkedSetCount = 0;
 		std::array<int, 3> frameFaces{-1, -1, -1};
+		// The frame faces' corners, copied from the shape so that each step
+		// reads them here rather than through the shape's face lists (three
+		// dependent cache misses per block): per face its corner count, then
+		// its corners. All zero when they do not fit (more than 256 vertices
+		// or 16 bytes): the shape's faces are read then.
+		std::array<std::uint8_t, 16> frameCorners{};
 		// Boxes and frame computed while the block was fixed (kept until it moves).
 		bool boxesBuilt = false;
 	};
@@ -213,6 +219,8 @@ private:
 	                std::vector<int>& divisionStart) const;
 	// Lays the covers' shells out in the flat arrays (after covers changed).
 	void layoutShells();
+	// Sets cover.frameCorners from its frame faces in `shape`.
+	static void copyFrameCorners(const ConvexPolyhedron& shape, BlockCover& cover);
 	void updateBoxes(const Block& block, BlockCover& cover, Frame& frame);
 	// Grid search: every shell pair (different blocks, not both fixed) whose
 	// `boxes` meet, into `out` (unsorted); returns the box comparisons made.
