@@ -311,6 +311,8 @@ void MSCCollider::layoutShells() {
 		cover.boxesBuilt = false;
 		total += cover.shellCount;
 	}
+	// A grid entry keeps a shell index in 29 bits (gridSearch).
+	if (total >= 1 << 29) throw InputError("MSCCollider: more than 2^29 shells (" + std::to_string(total) + ")");
 	resizeWithHeadroom(boxes_, total);
 	resizeWithHeadroom(extentLow_, total);
 	resizeWithHeadroom(extentHigh_, total);
@@ -395,8 +397,9 @@ long MSCCollider::gridSearch(const std::vector<Block>& blocks, const std::vector
 	// integer ranges computed once per shell).
 	const Vector3 origin = domain.min();
 	const double cell = std::max(sideSum / shellTotal, domain.sizes().maxCoeff() / kMaxCellsPerAxis);
+	// x >= origin (the domain holds every box), so truncation is the floor.
 	const auto cellOf = [&](const Vector3& x) {
-		return ((x - origin) / cell).array().floor().cast<long>().min(kMaxCellsPerAxis - 1).max(0).cast<int>().eval();
+		return ((x - origin) / cell).array().cast<long>().min(kMaxCellsPerAxis - 1).max(0).cast<int>().eval();
 	};
 	const Eigen::Array<long, 3, 1> dims = cellOf(domain.max()).cast<long>() + 1;
 	resizeWithHeadroom(cellLow_, shellTotal);
@@ -423,11 +426,10 @@ long MSCCollider::gridSearch(const std::vector<Block>& blocks, const std::vector
 	const bool dense = denseCells <= kDenseCellsPerEntry * static_cast<double>(entries) + kDenseCellsFloor &&
 	                   entries < std::numeric_limits<std::uint32_t>::max();
 	denseGrid_ = dense;
-	const auto key = [&](const Cell& c) {
-		return dense ? static_cast<std::uint64_t>((c.x() * dims.y() + c.y()) * dims.z() + c.z())
-		             : static_cast<std::uint64_t>(c.x()) << 42 | static_cast<std::uint64_t>(c.y()) << 21 |
-		                   static_cast<std::uint64_t>(c.z());
-	};
+	// A cell's key is linear in its coordinates: stride x coordinate, summed.
+	const std::array<std::uint64_t, 3> stride =
+	    dense ? std::array<std::uint64_t, 3>{static_cast<std::uint64_t>(dims.y() * dims.z()), static_cast<std::uint64_t>(dims.z()), 1}
+	          : std::array<std::uint64_t, 3>{std::uint64_t{1} << 42, std::uint64_t{1} << 21, 1};
 	// Per shell its block's fixed flag, read from one compact array (the
 	// blocks themselves are large and far apart in memory).
 	resizeWithHeadroom(shellFixed_, shellTotal);
@@ -447,21 +449,74 @@ long MSCCollider::gridSearch(const std::vector<Block>& blocks, const std::vector
 		tests += mine & pair;
 		if (mine & pair & meet) pushWithHeadroom(out, a < b ? ShellPair{s, t} : ShellPair{t, s});
 	};
-	// The shells of cell `here`: cellShells_[first, last), ascending; a pair
-	// is compared in the cell of the max of its lowest cells only.
-	const auto scanCell = [&](std::uint64_t here, std::size_t first, std::size_t last) {
-		for (std::size_t p = first; p < last; ++p)
-			for (std::size_t q = p + 1; q < last; ++q) {
-				const int s = cellShells_[p], t = cellShells_[q];
-				compare(s, t, key(cellLow_[s].max(cellLow_[t])) == here);
+	// Each entry is a shell (entry >> 3) and, in bits 0-2, the axes along
+	// which the cell is the shell's lowest. A pair is compared in the cell of
+	// the max of its lowest cells, which is the cell where, along every axis,
+	// one of the two begins: (bits of s | bits of t) == 7. About half of the
+	// pairs of a cell are not its own; in a cell of at most 64 entries each
+	// entry is compared only with the later ones whose bits complete its own,
+	// found as a bit mask. The entries are first copied with their boxes,
+	// blocks and fixed flags into cellScratch_, each box read once per cell
+	// rather than once per pair.
+	const auto scanCell = [&](std::size_t first, std::size_t last) {
+		const std::size_t count = last - first;
+		if (count > cellScratch_.size()) resizeWithHeadroom(cellScratch_, count);
+		CellEntry* entry = cellScratch_.data();
+		for (std::size_t p = 0; p < count; ++p) {
+			const std::uint32_t packed = cellShells_[first + p];
+			const int s = static_cast<int>(packed >> 3);
+			CellEntry& e = entry[p];
+			e.low = boxes[s].min();
+			e.high = boxes[s].max();
+			e.shell = s;
+			e.block = shellBlock_[s];
+			e.fixed = shellFixed_[s] != 0;
+			e.bits = static_cast<std::uint8_t>(packed & 7);
+		}
+		// A test when the blocks differ and are not both fixed, a shell pair
+		// when the boxes meet too (evaluated together, without a branch each:
+		// they are unpredictable and cheap).
+		long cellTests = 0;
+		const auto compare = [&](const CellEntry& e, const CellEntry& f) __attribute__((always_inline)) {
+			const bool test = (e.block != f.block) & !(e.fixed & f.fixed);
+			const bool meet = (e.low.x() <= f.high.x()) & (f.low.x() <= e.high.x()) & (e.low.y() <= f.high.y()) &
+			                  (f.low.y() <= e.high.y()) & (e.low.z() <= f.high.z()) & (f.low.z() <= e.high.z());
+			cellTests += test;
+			if (test & meet)
+				pushWithHeadroom(out, e.block < f.block ? ShellPair{e.shell, f.shell} : ShellPair{f.shell, e.shell});
+		};
+		if (count <= 64) {
+			// with[m]: the entries whose bits contain m (entries with bits m,
+			// then summed over supersets, one axis at a time).
+			std::uint64_t with[8] = {};
+			for (std::size_t p = 0; p < count; ++p) with[entry[p].bits] |= std::uint64_t{1} << p;
+			for (int m = 0; m < 8; m += 2) with[m] |= with[m + 1];
+			for (int m : {0, 1, 4, 5}) with[m] |= with[m + 2];
+			for (int m = 0; m < 4; ++m) with[m] |= with[m + 4];
+			for (std::size_t p = 0; p + 1 < count; ++p) {
+				const CellEntry e = entry[p];
+				for (std::uint64_t later = with[~e.bits & 7] & ~std::uint64_t{0} << (p + 1); later; later &= later - 1)
+					compare(e, entry[__builtin_ctzll(later)]);
 			}
+		} else {
+			for (std::size_t p = 0; p < count; ++p)
+				for (std::size_t q = p + 1; q < count; ++q)
+					if ((entry[p].bits | entry[q].bits) == 7) compare(entry[p], entry[q]);
+		}
+		tests += cellTests;
 	};
+	// Visits the cells of shell s with its entry there.
 	const auto forEachCellOf = [&](int s, const auto& visit) {
 		const Cell& lo = cellLow_[s];
-		const Cell hi = lo + Cell(cellSpan_[s].x, cellSpan_[s].y, cellSpan_[s].z);
-		for (int i = lo.x(); i <= hi.x(); ++i)
-			for (int j = lo.y(); j <= hi.y(); ++j)
-				for (int k = lo.z(); k <= hi.z(); ++k) visit(key(Cell(i, j, k)));
+		const int spanX = cellSpan_[s].x, spanY = cellSpan_[s].y, spanZ = cellSpan_[s].z;
+		const std::uint64_t base = lo.x() * stride[0] + lo.y() * stride[1] + lo.z();
+		const std::uint32_t shell = static_cast<std::uint32_t>(s) << 3;
+		for (int i = 0; i <= spanX; ++i)
+			for (int j = 0; j <= spanY; ++j) {
+				const std::uint64_t row = base + i * stride[0] + j * stride[1];
+				const std::uint32_t bits = shell | (i == 0) | (j == 0) << 1;
+				for (int k = 0; k <= spanZ; ++k) visit(row + k, bits | (k == 0) << 2);
+			}
 	};
 	resizeWithHeadroom(cellShells_, entries);
 	if (dense) {
@@ -472,25 +527,28 @@ long MSCCollider::gridSearch(const std::vector<Block>& blocks, const std::vector
 		resizeWithHeadroom(cellStart_, cells + 2);
 		std::fill(cellStart_.begin(), cellStart_.end(), 0);
 		for (int s = 0; s < shellTotal; ++s)
-			if (!cellSpan_[s].oversize) forEachCellOf(s, [&](std::uint64_t c) { ++cellStart_[c + 1]; });
+			if (!cellSpan_[s].oversize) forEachCellOf(s, [&](std::uint64_t c, std::uint32_t) { ++cellStart_[c + 1]; });
 		for (std::size_t c = 0; c < cells; ++c) cellStart_[c + 1] += cellStart_[c];
 		for (int s = shellTotal - 1; s >= 0; --s)
-			if (!cellSpan_[s].oversize) forEachCellOf(s, [&](std::uint64_t c) { cellShells_[--cellStart_[c + 1]] = s; });
+			if (!cellSpan_[s].oversize)
+				forEachCellOf(s, [&](std::uint64_t c, std::uint32_t e) { cellShells_[--cellStart_[c + 1]] = e; });
 		// Now cellStart_[c + 1] is the start of cell c; cell c is [cellStart_[c + 1], cellStart_[c + 2]).
 		cellStart_[cells + 1] = static_cast<std::uint32_t>(entries);
 		for (std::size_t c = 0; c < cells; ++c)
-			if (cellStart_[c + 2] - cellStart_[c + 1] > 1) scanCell(c, cellStart_[c + 1], cellStart_[c + 2]);
+			if (cellStart_[c + 2] - cellStart_[c + 1] > 1) scanCell(cellStart_[c + 1], cellStart_[c + 2]);
 	} else {
+		// By comparison on (cell key, entry): the entries of a cell ascend by shell.
 		cellEntries_.clear();
 		cellEntries_.reserve(entries);
 		for (int s = 0; s < shellTotal; ++s)
-			if (!cellSpan_[s].oversize) forEachCellOf(s, [&](std::uint64_t c) { cellEntries_.emplace_back(c, s); });
+			if (!cellSpan_[s].oversize)
+				forEachCellOf(s, [&](std::uint64_t c, std::uint32_t e) { cellEntries_.emplace_back(c, e); });
 		std::sort(cellEntries_.begin(), cellEntries_.end());
 		for (std::size_t p = 0; p < entries; ++p) cellShells_[p] = cellEntries_[p].second;
 		for (std::size_t first = 0; first < entries;) {
 			std::size_t last = first + 1;
 			while (last < entries && cellEntries_[last].first == cellEntries_[first].first) ++last;
-			scanCell(cellEntries_[first].first, first, last);
+			scanCell(first, last);
 			first = last;
 		}
 	}
@@ -697,18 +755,29 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 		const Frame& fa = frames_[a];
 		const Frame& fb = frames_[b];
 		const Vector3 between = fb.origin - fa.origin;
-		const Eigen::Matrix3d inA = fa.axes * fb.dual, inB = fb.axes * fa.dual;
-		const Eigen::Matrix3d sizeInA = inA.cwiseAbs(), sizeInB = inB.cwiseAbs();
-		const Vector3 offsetInA = fa.axes * between, offsetInB = fb.axes * (-between);
+		const Eigen::Matrix3d inA = fa.axes * fb.dual;
+		const Eigen::Matrix3d sizeInA = inA.cwiseAbs();
+		const Vector3 offsetInA = fa.axes * between;
 		const double roundoff =
 		    kFrameRoundoffRelative * (between.cwiseAbs().sum() + 10 * (fa.reach + fb.reach));
 		const double limit = 2 * margin + covers_[a].widening + covers_[b].widening + roundoff;
+		// The test in b's frame is set up when first needed: in about half of
+		// the block pairs every shell pair is apart in a's frame already.
+		Eigen::Matrix3d inB, sizeInB;
+		Vector3 offsetInB;
+		bool frameB = false;
 		std::uint64_t shellsA = 0, shellsB = 0;
+		stats.shellTests += static_cast<long>(end - h);
 		for (; h < end; ++h) {
 			const int s = hits_[h].s, t = hits_[h].t;
-			++stats.shellTests;
-			if (apartInFrame(s, t, inA, sizeInA, offsetInA, limit) || apartInFrame(t, s, inB, sizeInB, offsetInB, limit))
-				continue;
+			if (apartInFrame(s, t, inA, sizeInA, offsetInA, limit)) continue;
+			if (!frameB) {
+				inB = fb.axes * fa.dual;
+				sizeInB = inB.cwiseAbs();
+				offsetInB = fb.axes * (-between);
+				frameB = true;
+			}
+			if (apartInFrame(t, s, inB, sizeInB, offsetInB, limit)) continue;
 			++stats.shellPairs;
 			shellsA |= std::uint64_t{1} << (s - covers_[a].firstShell);
 			shellsB |= std::uint64_t{1} << (t - covers_[b].firstShell);
@@ -738,7 +807,7 @@ std::size_t MSCCollider::memoryBytes() const {
 	                    capacityBytes(extentLow_) + capacityBytes(extentHigh_) + capacityBytes(shellBlock_) +
 	                    capacityBytes(widened_) + capacityBytes(cellLow_) + capacityBytes(cellSpan_) +
 	                    capacityBytes(cellEntries_) + capacityBytes(cellShells_) + capacityBytes(cellStart_) +
-	                    capacityBytes(oversize_) + capacityBytes(shellFixed_) +
+	                    capacityBytes(cellScratch_) + capacityBytes(oversize_) + capacityBytes(shellFixed_) +
 	                    capacityBytes(pairStart_) + capacityBytes(pairNext_) + capacityBytes(hits_) +
 	                    capacityBytes(candidateSets_) + capacityBytes(linked_) + capacityBytes(linkedSets_) +
 	                    capacityBytes(lists_) + capacityBytes(listTable_) + capacityBytes(listScratch_) +

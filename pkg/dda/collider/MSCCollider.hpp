@@ -268,8 +268,18 @@ private:
 	};
 	std::vector<Cell> cellLow_;
 	std::vector<CellSpan> cellSpan_;
-	std::vector<std::pair<std::uint64_t, int>> cellEntries_;  // sparse keys: (cell key, shell), sorted
-	std::vector<int> cellShells_;             // every cell's shells, cell after cell
+	// A cell's entry as its pairs are compared (gridSearch).
+	struct CellEntry {
+		Vector3 low, high;  // the shell's box
+		int shell, block;
+		bool fixed;
+		std::uint8_t bits;  // bits 0-2 of its entry
+	};
+	std::vector<std::pair<std::uint64_t, std::uint32_t>> cellEntries_;  // sparse keys: (cell key, entry), sorted
+	// Every cell's entries, cell after cell: shell << 3 | the axes along
+	// which the cell is the shell's lowest (bit 0: x, 1: y, 2: z).
+	std::vector<std::uint32_t> cellShells_;
+	std::vector<CellEntry> cellScratch_;      // one cell's entries (gridSearch)
 	std::vector<std::uint32_t> cellStart_;    // dense keys: where each cell's shells start
 	bool denseGrid_ = false;
 	std::vector<int> oversize_;   // shells compared with every shell
