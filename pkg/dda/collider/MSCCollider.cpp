@@ -31,6 +31,9 @@ namespace dda {
 
 namespace {
 
+// Blocks ahead whose corners are prefetched while boxes are updated.
+constexpr int kPrefetchBlocks = 4;
+
 void checkCover(double criticalLength, int segments, const std::string& what) {
 	if (!(criticalLength > 0) || !std::isfinite(criticalLength))
 		throw InputError(what + ": critical length must be positive and finite, got " + std::to_string(criticalLength));
@@ -654,9 +657,18 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 	stats.shells = shellTotal;
 
 	// Boxes, frames and extents: moving blocks every call, fixed blocks once.
+	// The corners of the block kPrefetchBlocks ahead are fetched meanwhile
+	// (each block's are a separate allocation, usually out of cache).
 	const long updatesBefore = totalShellUpdates_;
-	for (int b = 0; b < n; ++b)
-		if (!blocks[b].fixed || !covers_[b].boxesBuilt) updateBoxes(blocks[b], covers_[b], frames_[b]);
+	const auto needsUpdate = [&](int b) { return !blocks[b].fixed || !covers_[b].boxesBuilt; };
+	for (int b = 0; b < n; ++b) {
+		if (b + kPrefetchBlocks < n && needsUpdate(b + kPrefetchBlocks)) {
+			const std::vector<Vector3>& ahead = blocks[b + kPrefetchBlocks].vertices;
+			const char* first = reinterpret_cast<const char*>(ahead.data());
+			for (std::size_t byte = 0; byte < ahead.size() * sizeof(Vector3); byte += 64) __builtin_prefetch(first + byte);
+		}
+		if (needsUpdate(b)) updateBoxes(blocks[b], covers_[b], frames_[b]);
+	}
 	stats.shellUpdates = totalShellUpdates_ - updatesBefore;
 	if (n < 2) return;
 
