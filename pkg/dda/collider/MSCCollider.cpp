@@ -274,6 +274,8 @@ void MSCCollider::updateBoxes(const Block& block, BlockCover& cover, Frame& fram
 	frame.dual = frame.axes.inverse();
 	frame.origin = x.front();
 	frame.reach = 0;
+	frame.widening = cover.widening;
+	frame.firstShell = cover.firstShell;
 	// Each point is computed once and added to the shells it lies in: a
 	// vertex to its linked shells, a division point to the two slabs of its
 	// plane. A shell gets its corners, then the points on its lower plane,
@@ -772,7 +774,7 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 		const Vector3 offsetInA = fa.axes * between;
 		const double roundoff =
 		    kFrameRoundoffRelative * (between.cwiseAbs().sum() + 10 * (fa.reach + fb.reach));
-		const double limit = 2 * margin + covers_[a].widening + covers_[b].widening + roundoff;
+		const double limit = 2 * margin + fa.widening + fb.widening + roundoff;
 		// The test in b's frame is set up when first needed: in about half of
 		// the block pairs every shell pair is apart in a's frame already.
 		Eigen::Matrix3d inB, sizeInB;
@@ -791,8 +793,8 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 			}
 			if (apartInFrame(t, s, inB, sizeInB, offsetInB, limit)) continue;
 			++stats.shellPairs;
-			shellsA |= std::uint64_t{1} << (s - covers_[a].firstShell);
-			shellsB |= std::uint64_t{1} << (t - covers_[b].firstShell);
+			shellsA |= std::uint64_t{1} << (s - fa.firstShell);
+			shellsB |= std::uint64_t{1} << (t - fb.firstShell);
 		}
 		if (shellsA) {
 			pairs.emplace_back(a, b);

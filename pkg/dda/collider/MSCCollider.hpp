@@ -196,12 +196,16 @@ private:
 	};
 	// A block's frame at this step: rows of `axes` are unit face normals (or
 	// the coordinate axes), `dual` = axes^-1; a shell's extent is the range of
-	// axes x (p - origin) over its points p.
-	struct Frame {
-		Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();
+	// axes x (p - origin) over its points p. With the cover's widening and
+	// first shell, what the frame test reads of a pair's second block (taken
+	// in no particular order) lies in the first two of its three cache lines.
+	struct alignas(64) Frame {
 		Eigen::Matrix3d dual = Eigen::Matrix3d::Identity();
 		Vector3 origin = Vector3::Zero();
-		double reach = 0;  // [m], largest |extent| of its shells (round-off scale)
+		double reach = 0;      // [m], largest |extent| of its shells (round-off scale)
+		double widening = 0;   // [m], its cover's
+		int firstShell = 0;    // its cover's
+		Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();
 	};
 	struct Override {
 		double criticalLength;
