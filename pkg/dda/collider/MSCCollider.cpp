@@ -330,10 +330,20 @@ void MSCCollider::layoutShells() {
 }
 
 int MSCCollider::linkedSet(int block, std::uint64_t shells) {
+	// The chain is searched from the set used last (a block's pairs often
+	// link the same shells), which is moved to its front when found.
+	int& head = frames_[block].linkedSets;
+	for (int k = head, previous = -1; k >= 0; previous = k, k = linkedSets_[k].next)
+		if (linkedSets_[k].shells == shells) {
+			if (previous >= 0) {
+				linkedSets_[previous].next = linkedSets_[k].next;
+				linkedSets_[k].next = head;
+				head = k;
+			}
+			return k;
+		}
 	BlockCover& cover = covers_[block];
-	for (int k = cover.linkedSets; k >= 0; k = linkedSets_[k].next)
-		if (linkedSets_[k].shells == shells) return k;
-	LinkedSet set{shells, cover.linkedSets, {}};
+	LinkedSet set{shells, head, {}};
 	const ShellRange* linkedShells = shellRanges_.data() + cover.firstSubUnit;
 	const int counts[3] = {cover.vertexCount, cover.edgeCount, cover.faceCount};
 	for (int kind = 0; kind < 3; ++kind) {
@@ -343,10 +353,10 @@ int MSCCollider::linkedSet(int block, std::uint64_t shells) {
 		linkedShells += counts[kind];
 		set.lists[kind] = internList(listScratch_);
 	}
-	cover.linkedSets = static_cast<int>(linkedSets_.size());
+	head = static_cast<int>(linkedSets_.size());
 	pushWithHeadroom(linkedSets_, set);
 	if (static_cast<std::size_t>(++cover.linkedSetCount) > kMaxLinkedSetsPerBlock) linkedSetsOverflow_ = true;
-	return cover.linkedSets;
+	return head;
 }
 
 int MSCCollider::internList(const std::vector<int>& list) {
@@ -374,10 +384,8 @@ void MSCCollider::clearLinkedSets() {
 	linkedSets_.clear();
 	lists_.clear();
 	std::fill(listTable_.begin(), listTable_.end(), -1);
-	for (BlockCover& cover : covers_) {
-		cover.linkedSets = -1;
-		cover.linkedSetCount = 0;
-	}
+	for (BlockCover& cover : covers_) cover.linkedSetCount = 0;
+	for (Frame& frame : frames_) frame.linkedSets = -1;
 	linkedSetsOverflow_ = false;
 }
 

@@ -175,8 +175,7 @@ private:
 		int firstShell = 0;    // into the flat shell arrays
 		int firstSubUnit = 0;  // into shellRanges_: its vertices, then edges, then faces
 		int vertexCount = 0, edgeCount = 0, faceCount = 0;
-		int linkedSets = -1;  // its newest set in linkedSets_ (a chain through next), -1: none
-		int linkedSetCount = 0;
+		int linkedSetCount = 0;  // its sets in linkedSets_ (the chain starts in its frame)
 		std::array<int, 3> frameFaces{-1, -1, -1};
 		// The frame faces' corners, copied from the shape so that each step
 		// reads them here rather than through the shape's face lists (three
@@ -191,20 +190,25 @@ private:
 	// of its vertices, edges and faces.
 	struct LinkedSet {
 		std::uint64_t shells;
-		int next;  // the block's previous set, -1: none
+		int next;  // the block's next set in its chain, -1: none
 		std::array<int, 3> lists;
 	};
 	// A block's frame at this step: rows of `axes` are unit face normals (or
 	// the coordinate axes), `dual` = axes^-1; a shell's extent is the range of
 	// axes x (p - origin) over its points p. With the cover's widening and
-	// first shell, what the frame test reads of a pair's second block (taken
-	// in no particular order) lies in the first two of its three cache lines.
+	// first shell, what the frame test and the linked sets read of a pair's
+	// second block (taken in no particular order) lies in the first two of
+	// its three cache lines.
 	struct alignas(64) Frame {
 		Eigen::Matrix3d dual = Eigen::Matrix3d::Identity();
 		Vector3 origin = Vector3::Zero();
 		double reach = 0;      // [m], largest |extent| of its shells (round-off scale)
 		double widening = 0;   // [m], its cover's
 		int firstShell = 0;    // its cover's
+		// The block's linked sets in linkedSets_, most recently used first (a
+		// chain through next), -1: none. Kept from call to call, unlike the
+		// rest, and read with the frame for the same cache lines.
+		int linkedSets = -1;
 		Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();
 	};
 	struct Override {
