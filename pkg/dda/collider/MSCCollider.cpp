@@ -571,30 +571,26 @@ long MSCCollider::gridSearch(const std::vector<Block>& blocks, const std::vector
 	return tests;
 }
 
-void MSCCollider::sortShellPairs(std::vector<ShellPair>& pairs, int blocks) {
-	// By counting on the first block, in place: bucket b is [pairStart_[b],
-	// pairStart_[b + 1]), filled up to pairNext_[b]; a pair found in another
-	// block's bucket is swapped to that bucket's next place. Then each block's
-	// few pairs by (t, s): flat shells go block after block, so the pairs of
-	// each second block follow one another, in ascending order (the order
-	// within a block pair changes nothing downstream).
+void MSCCollider::sortShellPairs(std::vector<ShellPair>& pairs, int blocks, std::vector<ShellPair>& scratch) {
+	// By counting on the first block: each pair, read in order, is written
+	// to its block's bucket in `scratch`, which is then swapped with `pairs`
+	// (the reads of the pairs' blocks are independent, where swapping pairs
+	// in place waited for one cache miss after another). pairStart_[b] is
+	// where bucket b starts, then where it ends. Then each block's few pairs
+	// by (t, s): flat shells go block after block, so the pairs of each
+	// second block follow one another, in ascending order (the order within
+	// a block pair changes nothing downstream).
 	pairStart_.assign(static_cast<std::size_t>(blocks) + 1, 0);
 	for (const ShellPair& p : pairs) ++pairStart_[shellBlock_[p.s] + 1];
 	for (int b = 0; b < blocks; ++b) pairStart_[b + 1] += pairStart_[b];
-	pairNext_.assign(pairStart_.begin(), pairStart_.end() - 1);
-	for (int b = 0; b < blocks; ++b)
-		while (pairNext_[b] < pairStart_[b + 1]) {
-			ShellPair& p = pairs[pairNext_[b]];
-			const int home = shellBlock_[p.s];
-			if (home == b)
-				++pairNext_[b];
-			else
-				std::swap(p, pairs[pairNext_[home]++]);
-		}
+	resizeWithHeadroom(scratch, pairs.size());
+	for (const ShellPair& p : pairs) scratch[pairStart_[shellBlock_[p.s]]++] = p;
+	pairs.swap(scratch);
 	const auto before = [](const ShellPair& x, const ShellPair& y) { return x.t < y.t || (x.t == y.t && x.s < y.s); };
-	for (int b = 0; b < blocks; ++b)
-		if (pairStart_[b + 1] - pairStart_[b] > 1)
-			std::sort(pairs.begin() + pairStart_[b], pairs.begin() + pairStart_[b + 1], before);
+	for (int b = 0; b < blocks; ++b) {
+		const std::size_t first = b > 0 ? pairStart_[b - 1] : 0;
+		if (pairStart_[b] - first > 1) std::sort(pairs.begin() + first, pairs.begin() + pairStart_[b], before);
+	}
 }
 
 bool MSCCollider::apartInFrame(int s, int t, const Eigen::Matrix3d& m, const Eigen::Matrix3d& size,
@@ -700,7 +696,7 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 		cacheValid_ = false;
 		stats.shellTests = gridSearch(blocks, widened_, hits_);
 		stats.blocksResearched = n;
-		sortShellPairs(hits_, n);
+		sortShellPairs(hits_, n, kept_);
 	} else {
 		// Blocks with a d0-box outside its D-box (the same floats as the
 		// final test: boxes inside D-boxes that meet imply D-boxes that meet).
@@ -727,7 +723,7 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 			searchedFixed_.resize(n);
 			for (int b = 0; b < n; ++b) searchedFixed_[b] = blocks[b].fixed;
 			stats.shellTests = gridSearch(blocks, searchBoxes_, cached_);
-			sortShellPairs(cached_, n);
+			sortShellPairs(cached_, n, kept_);
 			stats.blocksResearched = n;
 			cacheValid_ = true;
 		} else {
@@ -755,7 +751,7 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 								pushWithHeadroom(kept_, m < b ? ShellPair{s, t} : ShellPair{t, s});
 						}
 				}
-				sortShellPairs(kept_, n);
+				sortShellPairs(kept_, n, cached_);  // (what cached_ kept is in kept_ now)
 				cached_.swap(kept_);
 			} else {
 				stats.pairsReused = static_cast<long>(cached_.size());
@@ -830,7 +826,7 @@ std::size_t MSCCollider::memoryBytes() const {
 	                    capacityBytes(widened_) + capacityBytes(cellLow_) + capacityBytes(cellSpan_) +
 	                    capacityBytes(cellEntries_) + capacityBytes(cellShells_) + capacityBytes(cellStart_) +
 	                    capacityBytes(cellScratch_) + capacityBytes(oversize_) + capacityBytes(shellFixed_) +
-	                    capacityBytes(pairStart_) + capacityBytes(pairNext_) + capacityBytes(hits_) +
+	                    capacityBytes(pairStart_) + capacityBytes(hits_) +
 	                    capacityBytes(candidateSets_) + capacityBytes(linked_) + capacityBytes(linkedSets_) +
 	                    capacityBytes(lists_) + capacityBytes(listTable_) + capacityBytes(listScratch_) +
 	                    capacityBytes(searchBoxes_) + capacityBytes(cached_) + capacityBytes(kept_) +

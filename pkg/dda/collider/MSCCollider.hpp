@@ -239,8 +239,9 @@ private:
 	// elementwise, offset = a.axes x (b.origin - a.origin)).
 	bool apartInFrame(int s, int t, const Eigen::Matrix3d& m, const Eigen::Matrix3d& size, const Vector3& offset,
 	                  double limit) const;
-	// Sorts shell pairs by first block, then (t, s): by block pair.
-	void sortShellPairs(std::vector<ShellPair>& pairs, int blocks);
+	// Sorts shell pairs by first block, then (t, s): by block pair
+	// (`scratch`: work space, its contents lost).
+	void sortShellPairs(std::vector<ShellPair>& pairs, int blocks, std::vector<ShellPair>& scratch);
 	// Index into linkedSets_ of the block's set for `shells` (built when new).
 	int linkedSet(int block, std::uint64_t shells);
 	// Index into lists_ of a list equal to `list` (added when new).
@@ -292,7 +293,7 @@ private:
 	bool denseGrid_ = false;
 	std::vector<int> oversize_;   // shells compared with every shell
 	std::vector<char> shellFixed_;
-	std::vector<std::size_t> pairStart_, pairNext_;  // sortShellPairs' buckets
+	std::vector<std::size_t> pairStart_;  // sortShellPairs' buckets
 	std::vector<ShellPair> hits_;  // the shell pairs whose d0-boxes meet, sorted
 	// Per candidate its two linked sets, until linked_ is filled.
 	std::vector<std::array<int, 2>> candidateSets_;
