@@ -31,8 +31,10 @@ namespace dda {
 
 namespace {
 
-// Blocks ahead whose corners are prefetched while boxes are updated.
+// Blocks ahead whose corners are prefetched while boxes are updated, and
+// shell pairs ahead whose second block's frame is prefetched in the frame test.
 constexpr int kPrefetchBlocks = 4;
+constexpr std::size_t kPrefetchHits = 16;
 
 void checkCover(double criticalLength, int segments, const std::string& what) {
 	if (!(criticalLength > 0) || !std::isfinite(criticalLength))
@@ -766,7 +768,21 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 	// the union of their shells; a candidate links the union's sub-units
 	// (lists shared per block and shell set).
 	candidateSets_.clear();
+	// The second blocks' frames and shells' extents are far apart in memory:
+	// those of the shell pair kPrefetchHits ahead are fetched meanwhile.
+	std::size_t prefetched = 0;
+	const auto prefetchUpTo = [&](std::size_t ahead) {
+		for (ahead = std::min(ahead, hits_.size()); prefetched < ahead; ++prefetched) {
+			const int t = hits_[prefetched].t;
+			const char* frame = reinterpret_cast<const char*>(&frames_[shellBlock_[t]]);
+			__builtin_prefetch(frame);
+			__builtin_prefetch(frame + 64);
+			__builtin_prefetch(&extentLow_[t]);
+			__builtin_prefetch(&extentHigh_[t]);
+		}
+	};
 	for (std::size_t h = 0; h < hits_.size();) {
+		prefetchUpTo(h + kPrefetchHits);
 		const int a = shellBlock_[hits_[h].s], b = shellBlock_[hits_[h].t];
 		std::size_t end = h + 1;
 		while (end < hits_.size() && shellBlock_[hits_[end].s] == a && shellBlock_[hits_[end].t] == b) ++end;
