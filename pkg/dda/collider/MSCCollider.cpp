@@ -769,16 +769,22 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 	// (lists shared per block and shell set).
 	candidateSets_.clear();
 	// The second blocks' frames and shells' extents are far apart in memory:
-	// those of the shell pair kPrefetchHits ahead are fetched meanwhile.
-	std::size_t prefetched = 0;
+	// those of the shell pair kPrefetchHits ahead are fetched meanwhile, and
+	// the first linked set of the second block half as far ahead (its frame
+	// fetched by then).
+	std::size_t prefetched = 0, prefetchedSets = 0;
 	const auto prefetchUpTo = [&](std::size_t ahead) {
-		for (ahead = std::min(ahead, hits_.size()); prefetched < ahead; ++prefetched) {
+		for (std::size_t last = std::min(ahead, hits_.size()); prefetched < last; ++prefetched) {
 			const int t = hits_[prefetched].t;
 			const char* frame = reinterpret_cast<const char*>(&frames_[shellBlock_[t]]);
 			__builtin_prefetch(frame);
 			__builtin_prefetch(frame + 64);
 			__builtin_prefetch(&extentLow_[t]);
 			__builtin_prefetch(&extentHigh_[t]);
+		}
+		for (std::size_t last = std::min(ahead - kPrefetchHits / 2, hits_.size()); prefetchedSets < last; ++prefetchedSets) {
+			const int set = frames_[shellBlock_[hits_[prefetchedSets].t]].linkedSets;
+			if (set >= 0) __builtin_prefetch(&linkedSets_[set]);
 		}
 	};
 	for (std::size_t h = 0; h < hits_.size();) {
