@@ -391,8 +391,7 @@ void MSCCollider::clearLinkedSets() {
 	linkedSetsOverflow_ = false;
 }
 
-long MSCCollider::gridSearch(const std::vector<Block>& blocks, const std::vector<Eigen::AlignedBox3d>& boxes,
-                             std::vector<ShellPair>& out) {
+long MSCCollider::gridSearch(const std::vector<Eigen::AlignedBox3d>& boxes, std::vector<ShellPair>& out) {
 	out.clear();
 	const int shellTotal = static_cast<int>(boxes.size());
 	Eigen::AlignedBox3d domain;
@@ -445,10 +444,8 @@ long MSCCollider::gridSearch(const std::vector<Block>& blocks, const std::vector
 	const std::array<std::uint64_t, 3> stride =
 	    dense ? std::array<std::uint64_t, 3>{static_cast<std::uint64_t>(dims.y() * dims.z()), static_cast<std::uint64_t>(dims.z()), 1}
 	          : std::array<std::uint64_t, 3>{std::uint64_t{1} << 42, std::uint64_t{1} << 21, 1};
-	// Per shell its block's fixed flag, read from one compact array (the
-	// blocks themselves are large and far apart in memory).
-	resizeWithHeadroom(shellFixed_, shellTotal);
-	for (int s = 0; s < shellTotal; ++s) shellFixed_[s] = blocks[shellBlock_[s]].fixed;
+	// Per shell its block's fixed flag is read from shellFixed_ (filled as
+	// boxes are updated: the blocks themselves are large and far apart).
 	// Compares shells s and t if `mine` (this is where the pair is compared):
 	// a test when their blocks differ and are not both fixed, a shell pair
 	// when their boxes meet too. The conditions are evaluated together,
@@ -669,7 +666,9 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 	// (each block's are a separate allocation, usually out of cache).
 	const long updatesBefore = totalShellUpdates_;
 	const auto needsUpdate = [&](int b) { return !blocks[b].fixed || !covers_[b].boxesBuilt; };
+	resizeWithHeadroom(shellFixed_, shellTotal);
 	for (int b = 0; b < n; ++b) {
+		std::fill_n(shellFixed_.begin() + covers_[b].firstShell, covers_[b].shellCount, blocks[b].fixed);
 		if (b + kPrefetchBlocks < n && needsUpdate(b + kPrefetchBlocks)) {
 			const std::vector<Vector3>& ahead = blocks[b + kPrefetchBlocks].vertices;
 			const char* first = reinterpret_cast<const char*>(ahead.data());
@@ -696,7 +695,7 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 	hits_.clear();
 	if (!reuse_) {
 		cacheValid_ = false;
-		stats.shellTests = gridSearch(blocks, widened_, hits_);
+		stats.shellTests = gridSearch(widened_, hits_);
 		stats.blocksResearched = n;
 		sortShellPairs(hits_, n, kept_);
 	} else {
@@ -724,7 +723,7 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 			for (int s = 0; s < shellTotal; ++s) searchBoxes_[s] = searchBox(s);
 			searchedFixed_.resize(n);
 			for (int b = 0; b < n; ++b) searchedFixed_[b] = blocks[b].fixed;
-			stats.shellTests = gridSearch(blocks, searchBoxes_, cached_);
+			stats.shellTests = gridSearch(searchBoxes_, cached_);
 			sortShellPairs(cached_, n, kept_);
 			stats.blocksResearched = n;
 			cacheValid_ = true;

@@ -230,10 +230,10 @@ private:
 	// Sets cover.frameCorners from its frame faces in `shape`.
 	static void copyFrameCorners(const ConvexPolyhedron& shape, BlockCover& cover);
 	void updateBoxes(const Block& block, BlockCover& cover, Frame& frame);
-	// Grid search: every shell pair (different blocks, not both fixed) whose
-	// `boxes` meet, into `out` (unsorted); returns the box comparisons made.
-	long gridSearch(const std::vector<Block>& blocks, const std::vector<Eigen::AlignedBox3d>& boxes,
-	                std::vector<ShellPair>& out);
+	// Grid search: every shell pair (different blocks, not both fixed as
+	// shellFixed_ says) whose `boxes` meet, into `out` (unsorted); returns
+	// the box comparisons made.
+	long gridSearch(const std::vector<Eigen::AlignedBox3d>& boxes, std::vector<ShellPair>& out);
 	// Whether shells s of block a and t of block b are apart by more than
 	// `limit` [m] along an axis of a's frame (m = a.axes x b.dual, size = |m|
 	// elementwise, offset = a.axes x (b.origin - a.origin)).
@@ -292,7 +292,7 @@ private:
 	std::vector<std::uint32_t> cellStart_;    // dense keys: where each cell's shells start
 	bool denseGrid_ = false;
 	std::vector<int> oversize_;   // shells compared with every shell
-	std::vector<char> shellFixed_;
+	std::vector<char> shellFixed_;  // per flat shell, its block's fixed flag (set as boxes are updated)
 	std::vector<std::size_t> pairStart_;  // sortShellPairs' buckets
 	std::vector<ShellPair> hits_;  // the shell pairs whose d0-boxes meet, sorted
 	// Per candidate its two linked sets, until linked_ is filled.
