@@ -31,10 +31,12 @@ namespace dda {
 
 namespace {
 
-// Blocks ahead whose corners are prefetched while boxes are updated, and
+// Blocks ahead whose corners are prefetched while boxes are updated, grid
+// entries ahead whose shell's box is prefetched while cells are scanned, and
 // shell pairs ahead whose second block's frame is prefetched in the frame test.
 constexpr int kPrefetchBlocks = 4;
 constexpr std::size_t kPrefetchHits = 16;
+constexpr std::size_t kPrefetchEntries = 24;
 
 void checkCover(double criticalLength, int segments, const std::string& what) {
 	if (!(criticalLength > 0) || !std::isfinite(criticalLength))
@@ -470,7 +472,18 @@ long MSCCollider::gridSearch(const std::vector<Eigen::AlignedBox3d>& boxes, std:
 	// found as a bit mask. The entries are first copied with their boxes,
 	// blocks and fixed flags into cellScratch_, each box read once per cell
 	// rather than once per pair.
+	// Cells are scanned in the order of their entries, whose shells lie
+	// anywhere in the flat arrays: the boxes, blocks and fixed flags of the
+	// next kPrefetchEntries entries are fetched ahead (prefetched: entries done).
+	std::size_t prefetched = 0;
 	const auto scanCell = [&](std::size_t first, std::size_t last) {
+		for (const std::size_t ahead = std::min(entries, last + kPrefetchEntries); prefetched < ahead; ++prefetched) {
+			const std::uint32_t s = cellShells_[prefetched] >> 3;
+			__builtin_prefetch(&boxes[s]);
+			__builtin_prefetch(reinterpret_cast<const char*>(&boxes[s] + 1) - 1);
+			__builtin_prefetch(&shellBlock_[s]);
+			__builtin_prefetch(&shellFixed_[s]);
+		}
 		const std::size_t count = last - first;
 		if (count > cellScratch_.size()) resizeWithHeadroom(cellScratch_, count);
 		CellEntry* entry = cellScratch_.data();
