@@ -789,8 +789,7 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 		for (std::size_t last = std::min(ahead, hits_.size()); prefetched < last; ++prefetched) {
 			const int t = hits_[prefetched].t;
 			const char* frame = reinterpret_cast<const char*>(&frames_[shellBlock_[t]]);
-			__builtin_prefetch(frame);
-			__builtin_prefetch(frame + 64);
+			for (std::size_t byte = 0; byte < sizeof(Frame); byte += 64) __builtin_prefetch(frame + byte);
 			__builtin_prefetch(&extentLow_[t]);
 			__builtin_prefetch(&extentHigh_[t]);
 		}
