@@ -448,20 +448,20 @@ long MSCCollider::gridSearch(const std::vector<Eigen::AlignedBox3d>& boxes, std:
 	          : std::array<std::uint64_t, 3>{std::uint64_t{1} << 42, std::uint64_t{1} << 21, 1};
 	// Per shell its block's fixed flag is read from shellFixed_ (filled as
 	// boxes are updated: the blocks themselves are large and far apart).
-	// Compares shells s and t if `mine` (this is where the pair is compared):
-	// a test when their blocks differ and are not both fixed, a shell pair
-	// when their boxes meet too. The conditions are evaluated together,
-	// without a branch each (they are unpredictable and the tests cheap).
+	// An oversize shell is compared with every shell: a test when their
+	// blocks differ and are not both fixed, a shell pair when their boxes
+	// meet too. The conditions are evaluated together, without a branch each
+	// (they are unpredictable and the tests cheap); so they are in cells.
 	long tests = 0;
-	const auto compare = [&](int s, int t, bool mine) {
+	const auto compareShells = [&](int s, int t) {
 		const int a = shellBlock_[s], b = shellBlock_[t];
 		const bool pair = (a != b) & !(static_cast<bool>(shellFixed_[s]) & static_cast<bool>(shellFixed_[t]));
 		const Vector3 &lowS = boxes[s].min(), &highS = boxes[s].max();
 		const Vector3 &lowT = boxes[t].min(), &highT = boxes[t].max();
 		const bool meet = (lowS.x() <= highT.x()) & (lowT.x() <= highS.x()) & (lowS.y() <= highT.y()) &
 		                  (lowT.y() <= highS.y()) & (lowS.z() <= highT.z()) & (lowT.z() <= highS.z());
-		tests += mine & pair;
-		if (mine & pair & meet) pushWithHeadroom(out, a < b ? ShellPair{s, t} : ShellPair{t, s});
+		tests += pair;
+		if (pair & meet) pushWithHeadroom(out, a < b ? ShellPair{s, t} : ShellPair{t, s});
 	};
 	// Each entry is a shell (entry >> 3) and, in bits 0-2, the axes along
 	// which the cell is the shell's lowest. A pair is compared in the cell of
@@ -471,10 +471,10 @@ long MSCCollider::gridSearch(const std::vector<Eigen::AlignedBox3d>& boxes, std:
 	// entry is compared only with the later ones whose bits complete its own,
 	// found as a bit mask. The entries are first copied with their boxes,
 	// blocks and fixed flags into cellScratch_, each box read once per cell
-	// rather than once per pair.
-	// Cells are scanned in the order of their entries, whose shells lie
-	// anywhere in the flat arrays: the boxes, blocks and fixed flags of the
-	// next kPrefetchEntries entries are fetched ahead (prefetched: entries done).
+	// rather than once per pair. Cells are scanned in the order of their
+	// entries, whose shells lie anywhere in the flat arrays: the boxes, blocks
+	// and fixed flags of the next kPrefetchEntries entries are fetched ahead
+	// (`prefetched`: the entries done).
 	std::size_t prefetched = 0;
 	const auto scanCell = [&](std::size_t first, std::size_t last) {
 		for (const std::size_t ahead = std::min(entries, last + kPrefetchEntries); prefetched < ahead; ++prefetched) {
@@ -498,9 +498,7 @@ long MSCCollider::gridSearch(const std::vector<Eigen::AlignedBox3d>& boxes, std:
 			e.fixed = shellFixed_[s] != 0;
 			e.bits = static_cast<std::uint8_t>(packed & 7);
 		}
-		// A test when the blocks differ and are not both fixed, a shell pair
-		// when the boxes meet too (evaluated together, without a branch each:
-		// they are unpredictable and cheap).
+		// As compareShells, on the copies.
 		long cellTests = 0;
 		const auto compare = [&](const CellEntry& e, const CellEntry& f) __attribute__((always_inline)) {
 			const bool test = (e.block != f.block) & !(e.fixed & f.fixed);
@@ -579,7 +577,7 @@ long MSCCollider::gridSearch(const std::vector<Eigen::AlignedBox3d>& boxes, std:
 	}
 	for (int s : oversize_)
 		for (int t = 0; t < shellTotal; ++t)
-			if (t != s && (!cellSpan_[t].oversize || s < t)) compare(s, t, true);
+			if (t != s && (!cellSpan_[t].oversize || s < t)) compareShells(s, t);
 	return tests;
 }
 
@@ -765,7 +763,7 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 								pushWithHeadroom(kept_, m < b ? ShellPair{s, t} : ShellPair{t, s});
 						}
 				}
-				sortShellPairs(kept_, n, cached_);  // (what cached_ kept is in kept_ now)
+				sortShellPairs(kept_, n, cached_);  // (cached_'s pairs are in kept_ now: work space)
 				cached_.swap(kept_);
 			} else {
 				stats.pairsReused = static_cast<long>(cached_.size());
