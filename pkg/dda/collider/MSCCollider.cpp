@@ -31,6 +31,13 @@ namespace dda {
 
 namespace {
 
+// Blocks ahead whose corners are prefetched while boxes are updated, grid
+// entries ahead whose shell's box is prefetched while cells are scanned, and
+// shell pairs ahead whose second block's frame is prefetched in the frame test.
+constexpr int kPrefetchBlocks = 4;
+constexpr std::size_t kPrefetchHits = 16;
+constexpr std::size_t kPrefetchEntries = 24;
+
 void checkCover(double criticalLength, int segments, const std::string& what) {
 	if (!(criticalLength > 0) || !std::isfinite(criticalLength))
 		throw InputError(what + ": critical length must be positive and finite, got " + std::to_string(criticalLength));
@@ -42,11 +49,16 @@ void checkCover(double criticalLength, int segments, const std::string& what) {
 // The block's size [m]: its creation size, else the cube root of its volume.
 double blockSize(const Block& block) { return block.size > 0 ? block.size : std::cbrt(block.volume); }
 
-// A face's unit normal from its vector area (zero for a degenerate face).
-Vector3 faceNormal(const std::vector<int>& face, const std::vector<Vector3>& x) {
+// A face's unit normal from its vector area (zero for a degenerate face):
+// the face's corners are face[0, n).
+template <class Index>
+Vector3 faceNormal(const Index* face, std::size_t n, const std::vector<Vector3>& x) {
 	Vector3 area = Vector3::Zero();
-	for (std::size_t k = 1; k + 1 < face.size(); ++k) area += (x[face[k]] - x[face[0]]).cross(x[face[k + 1]] - x[face[0]]);
+	for (std::size_t k = 1; k + 1 < n; ++k) area += (x[face[k]] - x[face[0]]).cross(x[face[k + 1]] - x[face[0]]);
 	return area.normalized();
+}
+Vector3 faceNormal(const std::vector<int>& face, const std::vector<Vector3>& x) {
+	return faceNormal(face.data(), face.size(), x);
 }
 
 // A shell's box (min, max) and extent in its block's frame (low, high) as
@@ -185,6 +197,7 @@ void MSCCollider::buildCover(const Block& block, double criticalLength, int segm
 		const int f3 = best([&](const Vector3& n) { return std::abs(n.dot(across)); }, f1);
 		if (f3 >= 0 && std::abs(normals[f3].dot(across)) >= kMinFrameDeterminant) cover.frameFaces = {f1, f2, f3};
 	}
+	copyFrameCorners(shape, cover);
 	if (k == 1) {
 		shellRanges.insert(shellRanges.end(), nv + ne + nf, ShellRange::of(1));
 		divisionStart.push_back(static_cast<int>(divisions.size()));
@@ -233,6 +246,19 @@ void MSCCollider::buildCover(const Block& block, double criticalLength, int segm
 	}
 }
 
+void MSCCollider::copyFrameCorners(const ConvexPolyhedron& shape, BlockCover& cover) {
+	cover.frameCorners.fill(0);
+	if (cover.frameFaces[0] < 0 || shape.vertices.size() > 256) return;
+	std::size_t used = 0;
+	for (const int f : cover.frameFaces) used += 1 + shape.faces[f].size();
+	if (used > cover.frameCorners.size()) return;
+	std::uint8_t* out = cover.frameCorners.data();
+	for (const int f : cover.frameFaces) {
+		*out++ = static_cast<std::uint8_t>(shape.faces[f].size());
+		for (const int v : shape.faces[f]) *out++ = static_cast<std::uint8_t>(v);
+	}
+}
+
 void MSCCollider::updateBoxes(const Block& block, BlockCover& cover, Frame& frame) {
 	const ConvexPolyhedron& shape = *block.shape;
 	const std::vector<Vector3>& x = block.vertices;
@@ -240,12 +266,20 @@ void MSCCollider::updateBoxes(const Block& block, BlockCover& cover, Frame& fram
 	frame.axes.setIdentity();
 	if (cover.frameFaces[0] >= 0) {
 		Eigen::Matrix3d axes;
-		for (int j = 0; j < 3; ++j) axes.row(j) = faceNormal(shape.faces[cover.frameFaces[j]], x).transpose();
+		if (cover.frameCorners[0] > 0) {
+			const std::uint8_t* corners = cover.frameCorners.data();
+			for (int j = 0; j < 3; corners += 1 + corners[0], ++j)
+				axes.row(j) = faceNormal(corners + 1, corners[0], x).transpose();
+		} else {
+			for (int j = 0; j < 3; ++j) axes.row(j) = faceNormal(shape.faces[cover.frameFaces[j]], x).transpose();
+		}
 		if (std::abs(axes.determinant()) >= 0.5 * kMinFrameDeterminant) frame.axes = axes;
 	}
 	frame.dual = frame.axes.inverse();
 	frame.origin = x.front();
 	frame.reach = 0;
+	frame.widening = cover.widening;
+	frame.firstShell = cover.firstShell;
 	// Each point is computed once and added to the shells it lies in: a
 	// vertex to its linked shells, a division point to the two slabs of its
 	// plane. A shell gets its corners, then the points on its lower plane,
@@ -286,6 +320,8 @@ void MSCCollider::layoutShells() {
 		cover.boxesBuilt = false;
 		total += cover.shellCount;
 	}
+	// A grid entry keeps a shell index in 29 bits (gridSearch).
+	if (total >= 1 << 29) throw InputError("MSCCollider: more than 2^29 shells (" + std::to_string(total) + ")");
 	resizeWithHeadroom(boxes_, total);
 	resizeWithHeadroom(extentLow_, total);
 	resizeWithHeadroom(extentHigh_, total);
@@ -298,10 +334,20 @@ void MSCCollider::layoutShells() {
 }
 
 int MSCCollider::linkedSet(int block, std::uint64_t shells) {
+	// The chain is searched from the set used last (a block's pairs often
+	// link the same shells), which is moved to its front when found.
+	int& head = frames_[block].linkedSets;
+	for (int k = head, previous = -1; k >= 0; previous = k, k = linkedSets_[k].next)
+		if (linkedSets_[k].shells == shells) {
+			if (previous >= 0) {
+				linkedSets_[previous].next = linkedSets_[k].next;
+				linkedSets_[k].next = head;
+				head = k;
+			}
+			return k;
+		}
 	BlockCover& cover = covers_[block];
-	for (int k = cover.linkedSets; k >= 0; k = linkedSets_[k].next)
-		if (linkedSets_[k].shells == shells) return k;
-	LinkedSet set{shells, cover.linkedSets, {}};
+	LinkedSet set{shells, head, {}};
 	const ShellRange* linkedShells = shellRanges_.data() + cover.firstSubUnit;
 	const int counts[3] = {cover.vertexCount, cover.edgeCount, cover.faceCount};
 	for (int kind = 0; kind < 3; ++kind) {
@@ -311,10 +357,10 @@ int MSCCollider::linkedSet(int block, std::uint64_t shells) {
 		linkedShells += counts[kind];
 		set.lists[kind] = internList(listScratch_);
 	}
-	cover.linkedSets = static_cast<int>(linkedSets_.size());
+	head = static_cast<int>(linkedSets_.size());
 	pushWithHeadroom(linkedSets_, set);
 	if (static_cast<std::size_t>(++cover.linkedSetCount) > kMaxLinkedSetsPerBlock) linkedSetsOverflow_ = true;
-	return cover.linkedSets;
+	return head;
 }
 
 int MSCCollider::internList(const std::vector<int>& list) {
@@ -342,15 +388,12 @@ void MSCCollider::clearLinkedSets() {
 	linkedSets_.clear();
 	lists_.clear();
 	std::fill(listTable_.begin(), listTable_.end(), -1);
-	for (BlockCover& cover : covers_) {
-		cover.linkedSets = -1;
-		cover.linkedSetCount = 0;
-	}
+	for (BlockCover& cover : covers_) cover.linkedSetCount = 0;
+	for (Frame& frame : frames_) frame.linkedSets = -1;
 	linkedSetsOverflow_ = false;
 }
 
-long MSCCollider::gridSearch(const std::vector<Block>& blocks, const std::vector<Eigen::AlignedBox3d>& boxes,
-                             std::vector<ShellPair>& out) {
+long MSCCollider::gridSearch(const std::vector<Eigen::AlignedBox3d>& boxes, std::vector<ShellPair>& out) {
 	out.clear();
 	const int shellTotal = static_cast<int>(boxes.size());
 	Eigen::AlignedBox3d domain;
@@ -370,8 +413,9 @@ long MSCCollider::gridSearch(const std::vector<Block>& blocks, const std::vector
 	// integer ranges computed once per shell).
 	const Vector3 origin = domain.min();
 	const double cell = std::max(sideSum / shellTotal, domain.sizes().maxCoeff() / kMaxCellsPerAxis);
+	// x >= origin (the domain holds every box), so truncation is the floor.
 	const auto cellOf = [&](const Vector3& x) {
-		return ((x - origin) / cell).array().floor().cast<long>().min(kMaxCellsPerAxis - 1).max(0).cast<int>().eval();
+		return ((x - origin) / cell).array().cast<long>().min(kMaxCellsPerAxis - 1).max(0).cast<int>().eval();
 	};
 	const Eigen::Array<long, 3, 1> dims = cellOf(domain.max()).cast<long>() + 1;
 	resizeWithHeadroom(cellLow_, shellTotal);
@@ -398,45 +442,104 @@ long MSCCollider::gridSearch(const std::vector<Block>& blocks, const std::vector
 	const bool dense = denseCells <= kDenseCellsPerEntry * static_cast<double>(entries) + kDenseCellsFloor &&
 	                   entries < std::numeric_limits<std::uint32_t>::max();
 	denseGrid_ = dense;
-	const auto key = [&](const Cell& c) {
-		return dense ? static_cast<std::uint64_t>((c.x() * dims.y() + c.y()) * dims.z() + c.z())
-		             : static_cast<std::uint64_t>(c.x()) << 42 | static_cast<std::uint64_t>(c.y()) << 21 |
-		                   static_cast<std::uint64_t>(c.z());
-	};
-	// Per shell its block's fixed flag, read from one compact array (the
-	// blocks themselves are large and far apart in memory).
-	resizeWithHeadroom(shellFixed_, shellTotal);
-	for (int s = 0; s < shellTotal; ++s) shellFixed_[s] = blocks[shellBlock_[s]].fixed;
-	// Compares shells s and t if `mine` (this is where the pair is compared):
-	// a test when their blocks differ and are not both fixed, a shell pair
-	// when their boxes meet too. The conditions are evaluated together,
-	// without a branch each (they are unpredictable and the tests cheap).
+	// A cell's key is linear in its coordinates: stride x coordinate, summed.
+	const std::array<std::uint64_t, 3> stride =
+	    dense ? std::array<std::uint64_t, 3>{static_cast<std::uint64_t>(dims.y() * dims.z()), static_cast<std::uint64_t>(dims.z()), 1}
+	          : std::array<std::uint64_t, 3>{std::uint64_t{1} << 42, std::uint64_t{1} << 21, 1};
+	// Per shell its block's fixed flag is read from shellFixed_ (filled as
+	// boxes are updated: the blocks themselves are large and far apart).
+	// An oversize shell is compared with every shell: a test when their
+	// blocks differ and are not both fixed, a shell pair when their boxes
+	// meet too. The conditions are evaluated together, without a branch each
+	// (they are unpredictable and the tests cheap); so they are in cells.
 	long tests = 0;
-	const auto compare = [&](int s, int t, bool mine) {
+	const auto compareShells = [&](int s, int t) {
 		const int a = shellBlock_[s], b = shellBlock_[t];
 		const bool pair = (a != b) & !(static_cast<bool>(shellFixed_[s]) & static_cast<bool>(shellFixed_[t]));
 		const Vector3 &lowS = boxes[s].min(), &highS = boxes[s].max();
 		const Vector3 &lowT = boxes[t].min(), &highT = boxes[t].max();
 		const bool meet = (lowS.x() <= highT.x()) & (lowT.x() <= highS.x()) & (lowS.y() <= highT.y()) &
 		                  (lowT.y() <= highS.y()) & (lowS.z() <= highT.z()) & (lowT.z() <= highS.z());
-		tests += mine & pair;
-		if (mine & pair & meet) pushWithHeadroom(out, a < b ? ShellPair{s, t} : ShellPair{t, s});
+		tests += pair;
+		if (pair & meet) pushWithHeadroom(out, a < b ? ShellPair{s, t} : ShellPair{t, s});
 	};
-	// The shells of cell `here`: cellShells_[first, last), ascending; a pair
-	// is compared in the cell of the max of its lowest cells only.
-	const auto scanCell = [&](std::uint64_t here, std::size_t first, std::size_t last) {
-		for (std::size_t p = first; p < last; ++p)
-			for (std::size_t q = p + 1; q < last; ++q) {
-				const int s = cellShells_[p], t = cellShells_[q];
-				compare(s, t, key(cellLow_[s].max(cellLow_[t])) == here);
+	// Each entry is a shell (entry >> 3) and, in bits 0-2, the axes along
+	// which the cell is the shell's lowest. A pair is compared in the cell of
+	// the max of its lowest cells, which is the cell where, along every axis,
+	// one of the two begins: (bits of s | bits of t) == 7. About half of the
+	// pairs of a cell are not its own; in a cell of at most 64 entries each
+	// entry is compared only with the later ones whose bits complete its own,
+	// found as a bit mask. The entries are first copied with their boxes,
+	// blocks and fixed flags into cellScratch_, each box read once per cell
+	// rather than once per pair. Cells are scanned in the order of their
+	// entries, whose shells lie anywhere in the flat arrays: the boxes, blocks
+	// and fixed flags of the next kPrefetchEntries entries are fetched ahead
+	// (`prefetched`: the entries done).
+	std::size_t prefetched = 0;
+	const auto scanCell = [&](std::size_t first, std::size_t last) {
+		for (const std::size_t ahead = std::min(entries, last + kPrefetchEntries); prefetched < ahead; ++prefetched) {
+			const std::uint32_t s = cellShells_[prefetched] >> 3;
+			__builtin_prefetch(&boxes[s]);
+			__builtin_prefetch(reinterpret_cast<const char*>(&boxes[s] + 1) - 1);
+			__builtin_prefetch(&shellBlock_[s]);
+			__builtin_prefetch(&shellFixed_[s]);
+		}
+		const std::size_t count = last - first;
+		if (count > cellScratch_.size()) resizeWithHeadroom(cellScratch_, count);
+		CellEntry* entry = cellScratch_.data();
+		for (std::size_t p = 0; p < count; ++p) {
+			const std::uint32_t packed = cellShells_[first + p];
+			const int s = static_cast<int>(packed >> 3);
+			CellEntry& e = entry[p];
+			e.low = boxes[s].min();
+			e.high = boxes[s].max();
+			e.shell = s;
+			e.block = shellBlock_[s];
+			e.fixed = shellFixed_[s] != 0;
+			e.bits = static_cast<std::uint8_t>(packed & 7);
+		}
+		// As compareShells, on the copies.
+		long cellTests = 0;
+		const auto compare = [&](const CellEntry& e, const CellEntry& f) __attribute__((always_inline)) {
+			const bool test = (e.block != f.block) & !(e.fixed & f.fixed);
+			const bool meet = (e.low.x() <= f.high.x()) & (f.low.x() <= e.high.x()) & (e.low.y() <= f.high.y()) &
+			                  (f.low.y() <= e.high.y()) & (e.low.z() <= f.high.z()) & (f.low.z() <= e.high.z());
+			cellTests += test;
+			if (test & meet)
+				pushWithHeadroom(out, e.block < f.block ? ShellPair{e.shell, f.shell} : ShellPair{f.shell, e.shell});
+		};
+		if (count <= 64) {
+			// with[m]: the entries whose bits contain m (entries with bits m,
+			// then summed over supersets, one axis at a time).
+			std::uint64_t with[8] = {};
+			for (std::size_t p = 0; p < count; ++p) with[entry[p].bits] |= std::uint64_t{1} << p;
+			for (int m = 0; m < 8; m += 2) with[m] |= with[m + 1];
+			for (int m : {0, 1, 4, 5}) with[m] |= with[m + 2];
+			for (int m = 0; m < 4; ++m) with[m] |= with[m + 4];
+			for (std::size_t p = 0; p + 1 < count; ++p) {
+				const CellEntry e = entry[p];
+				for (std::uint64_t later = with[~e.bits & 7] & ~std::uint64_t{0} << (p + 1); later; later &= later - 1)
+					compare(e, entry[__builtin_ctzll(later)]);
 			}
+		} else {
+			for (std::size_t p = 0; p < count; ++p)
+				for (std::size_t q = p + 1; q < count; ++q)
+					if ((entry[p].bits | entry[q].bits) == 7) compare(entry[p], entry[q]);
+		}
+		tests += cellTests;
 	};
+	// Visits the cells of shell s with its entry there.
 	const auto forEachCellOf = [&](int s, const auto& visit) {
 		const Cell& lo = cellLow_[s];
-		const Cell hi = lo + Cell(cellSpan_[s].x, cellSpan_[s].y, cellSpan_[s].z);
-		for (int i = lo.x(); i <= hi.x(); ++i)
-			for (int j = lo.y(); j <= hi.y(); ++j)
-				for (int k = lo.z(); k <= hi.z(); ++k) visit(key(Cell(i, j, k)));
+		const int spanX = cellSpan_[s].x, spanY = cellSpan_[s].y, spanZ = cellSpan_[s].z;
+		const std::uint64_t base = lo.x() * stride[0] + lo.y() * stride[1] + lo.z();
+		const std::uint32_t shell = static_cast<std::uint32_t>(s) << 3;
+		for (int i = 0; i <= spanX; ++i)
+			for (int j = 0; j <= spanY; ++j) {
+				const std::uint64_t row = base + i * stride[0] + j * stride[1];
+				const std::uint32_t bits = shell | (i == 0) | (j == 0) << 1;
+				for (int k = 0; k <= spanZ; ++k) visit(row + k, bits | (k == 0) << 2);
+			}
 	};
 	resizeWithHeadroom(cellShells_, entries);
 	if (dense) {
@@ -447,58 +550,57 @@ long MSCCollider::gridSearch(const std::vector<Block>& blocks, const std::vector
 		resizeWithHeadroom(cellStart_, cells + 2);
 		std::fill(cellStart_.begin(), cellStart_.end(), 0);
 		for (int s = 0; s < shellTotal; ++s)
-			if (!cellSpan_[s].oversize) forEachCellOf(s, [&](std::uint64_t c) { ++cellStart_[c + 1]; });
+			if (!cellSpan_[s].oversize) forEachCellOf(s, [&](std::uint64_t c, std::uint32_t) { ++cellStart_[c + 1]; });
 		for (std::size_t c = 0; c < cells; ++c) cellStart_[c + 1] += cellStart_[c];
 		for (int s = shellTotal - 1; s >= 0; --s)
-			if (!cellSpan_[s].oversize) forEachCellOf(s, [&](std::uint64_t c) { cellShells_[--cellStart_[c + 1]] = s; });
+			if (!cellSpan_[s].oversize)
+				forEachCellOf(s, [&](std::uint64_t c, std::uint32_t e) { cellShells_[--cellStart_[c + 1]] = e; });
 		// Now cellStart_[c + 1] is the start of cell c; cell c is [cellStart_[c + 1], cellStart_[c + 2]).
 		cellStart_[cells + 1] = static_cast<std::uint32_t>(entries);
 		for (std::size_t c = 0; c < cells; ++c)
-			if (cellStart_[c + 2] - cellStart_[c + 1] > 1) scanCell(c, cellStart_[c + 1], cellStart_[c + 2]);
+			if (cellStart_[c + 2] - cellStart_[c + 1] > 1) scanCell(cellStart_[c + 1], cellStart_[c + 2]);
 	} else {
+		// By comparison on (cell key, entry): the entries of a cell ascend by shell.
 		cellEntries_.clear();
 		cellEntries_.reserve(entries);
 		for (int s = 0; s < shellTotal; ++s)
-			if (!cellSpan_[s].oversize) forEachCellOf(s, [&](std::uint64_t c) { cellEntries_.emplace_back(c, s); });
+			if (!cellSpan_[s].oversize)
+				forEachCellOf(s, [&](std::uint64_t c, std::uint32_t e) { cellEntries_.emplace_back(c, e); });
 		std::sort(cellEntries_.begin(), cellEntries_.end());
 		for (std::size_t p = 0; p < entries; ++p) cellShells_[p] = cellEntries_[p].second;
 		for (std::size_t first = 0; first < entries;) {
 			std::size_t last = first + 1;
 			while (last < entries && cellEntries_[last].first == cellEntries_[first].first) ++last;
-			scanCell(cellEntries_[first].first, first, last);
+			scanCell(first, last);
 			first = last;
 		}
 	}
 	for (int s : oversize_)
 		for (int t = 0; t < shellTotal; ++t)
-			if (t != s && (!cellSpan_[t].oversize || s < t)) compare(s, t, true);
+			if (t != s && (!cellSpan_[t].oversize || s < t)) compareShells(s, t);
 	return tests;
 }
 
-void MSCCollider::sortShellPairs(std::vector<ShellPair>& pairs, int blocks) {
-	// By counting on the first block, in place: bucket b is [pairStart_[b],
-	// pairStart_[b + 1]), filled up to pairNext_[b]; a pair found in another
-	// block's bucket is swapped to that bucket's next place. Then each block's
-	// few pairs by (t, s): flat shells go block after block, so the pairs of
-	// each second block follow one another, in ascending order (the order
-	// within a block pair changes nothing downstream).
+void MSCCollider::sortShellPairs(std::vector<ShellPair>& pairs, int blocks, std::vector<ShellPair>& scratch) {
+	// By counting on the first block: each pair, read in order, is written
+	// to its block's bucket in `scratch`, which is then swapped with `pairs`
+	// (the reads of the pairs' blocks are independent, where swapping pairs
+	// in place waited for one cache miss after another). pairStart_[b] is
+	// where bucket b starts, then where it ends. Then each block's few pairs
+	// by (t, s): flat shells go block after block, so the pairs of each
+	// second block follow one another, in ascending order (the order within
+	// a block pair changes nothing downstream).
 	pairStart_.assign(static_cast<std::size_t>(blocks) + 1, 0);
 	for (const ShellPair& p : pairs) ++pairStart_[shellBlock_[p.s] + 1];
 	for (int b = 0; b < blocks; ++b) pairStart_[b + 1] += pairStart_[b];
-	pairNext_.assign(pairStart_.begin(), pairStart_.end() - 1);
-	for (int b = 0; b < blocks; ++b)
-		while (pairNext_[b] < pairStart_[b + 1]) {
-			ShellPair& p = pairs[pairNext_[b]];
-			const int home = shellBlock_[p.s];
-			if (home == b)
-				++pairNext_[b];
-			else
-				std::swap(p, pairs[pairNext_[home]++]);
-		}
+	resizeWithHeadroom(scratch, pairs.size());
+	for (const ShellPair& p : pairs) scratch[pairStart_[shellBlock_[p.s]]++] = p;
+	pairs.swap(scratch);
 	const auto before = [](const ShellPair& x, const ShellPair& y) { return x.t < y.t || (x.t == y.t && x.s < y.s); };
-	for (int b = 0; b < blocks; ++b)
-		if (pairStart_[b + 1] - pairStart_[b] > 1)
-			std::sort(pairs.begin() + pairStart_[b], pairs.begin() + pairStart_[b + 1], before);
+	for (int b = 0; b < blocks; ++b) {
+		const std::size_t first = b > 0 ? pairStart_[b - 1] : 0;
+		if (pairStart_[b] - first > 1) std::sort(pairs.begin() + first, pairs.begin() + pairStart_[b], before);
+	}
 }
 
 bool MSCCollider::apartInFrame(int s, int t, const Eigen::Matrix3d& m, const Eigen::Matrix3d& size,
@@ -571,9 +673,20 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 	stats.shells = shellTotal;
 
 	// Boxes, frames and extents: moving blocks every call, fixed blocks once.
+	// The corners of the block kPrefetchBlocks ahead are fetched meanwhile
+	// (each block's are a separate allocation, usually out of cache).
 	const long updatesBefore = totalShellUpdates_;
-	for (int b = 0; b < n; ++b)
-		if (!blocks[b].fixed || !covers_[b].boxesBuilt) updateBoxes(blocks[b], covers_[b], frames_[b]);
+	const auto needsUpdate = [&](int b) { return !blocks[b].fixed || !covers_[b].boxesBuilt; };
+	resizeWithHeadroom(shellFixed_, shellTotal);
+	for (int b = 0; b < n; ++b) {
+		std::fill_n(shellFixed_.begin() + covers_[b].firstShell, covers_[b].shellCount, blocks[b].fixed);
+		if (b + kPrefetchBlocks < n && needsUpdate(b + kPrefetchBlocks)) {
+			const std::vector<Vector3>& ahead = blocks[b + kPrefetchBlocks].vertices;
+			const char* first = reinterpret_cast<const char*>(ahead.data());
+			for (std::size_t byte = 0; byte < ahead.size() * sizeof(Vector3); byte += 64) __builtin_prefetch(first + byte);
+		}
+		if (needsUpdate(b)) updateBoxes(blocks[b], covers_[b], frames_[b]);
+	}
 	stats.shellUpdates = totalShellUpdates_ - updatesBefore;
 	if (n < 2) return;
 
@@ -593,9 +706,9 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 	hits_.clear();
 	if (!reuse_) {
 		cacheValid_ = false;
-		stats.shellTests = gridSearch(blocks, widened_, hits_);
+		stats.shellTests = gridSearch(widened_, hits_);
 		stats.blocksResearched = n;
-		sortShellPairs(hits_, n);
+		sortShellPairs(hits_, n, kept_);
 	} else {
 		// Blocks with a d0-box outside its D-box (the same floats as the
 		// final test: boxes inside D-boxes that meet imply D-boxes that meet).
@@ -621,8 +734,8 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 			for (int s = 0; s < shellTotal; ++s) searchBoxes_[s] = searchBox(s);
 			searchedFixed_.resize(n);
 			for (int b = 0; b < n; ++b) searchedFixed_[b] = blocks[b].fixed;
-			stats.shellTests = gridSearch(blocks, searchBoxes_, cached_);
-			sortShellPairs(cached_, n);
+			stats.shellTests = gridSearch(searchBoxes_, cached_);
+			sortShellPairs(cached_, n, kept_);
 			stats.blocksResearched = n;
 			cacheValid_ = true;
 		} else {
@@ -650,14 +763,23 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 								pushWithHeadroom(kept_, m < b ? ShellPair{s, t} : ShellPair{t, s});
 						}
 				}
-				sortShellPairs(kept_, n);
+				sortShellPairs(kept_, n, cached_);  // (cached_'s pairs are in kept_ now: work space)
 				cached_.swap(kept_);
 			} else {
 				stats.pairsReused = static_cast<long>(cached_.size());
 			}
 		}
-		for (const ShellPair& p : cached_)
+		// (The second shells lie anywhere: the box of the one kPrefetchHits
+		// pairs ahead is fetched meanwhile.)
+		for (std::size_t k = 0; k < cached_.size(); ++k) {
+			if (k + kPrefetchHits < cached_.size()) {
+				const Eigen::AlignedBox3d* ahead = &widened_[cached_[k + kPrefetchHits].t];
+				__builtin_prefetch(ahead);
+				__builtin_prefetch(reinterpret_cast<const char*>(ahead + 1) - 1);
+			}
+			const ShellPair& p = cached_[k];
 			if (widened_[p.s].intersects(widened_[p.t])) pushWithHeadroom(hits_, p);
+		}
 		stats.shellTests += static_cast<long>(cached_.size());
 	}
 
@@ -665,28 +787,58 @@ void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDist
 	// the union of their shells; a candidate links the union's sub-units
 	// (lists shared per block and shell set).
 	candidateSets_.clear();
+	// The second blocks' frames and shells' extents are far apart in memory:
+	// those of the shell pair kPrefetchHits ahead are fetched meanwhile, and
+	// the first linked set of the second block half as far ahead (its frame
+	// fetched by then).
+	std::size_t prefetched = 0, prefetchedSets = 0;
+	const auto prefetchUpTo = [&](std::size_t ahead) {
+		for (std::size_t last = std::min(ahead, hits_.size()); prefetched < last; ++prefetched) {
+			const int t = hits_[prefetched].t;
+			const char* frame = reinterpret_cast<const char*>(&frames_[shellBlock_[t]]);
+			for (std::size_t byte = 0; byte < sizeof(Frame); byte += 64) __builtin_prefetch(frame + byte);
+			__builtin_prefetch(&extentLow_[t]);
+			__builtin_prefetch(&extentHigh_[t]);
+		}
+		for (std::size_t last = std::min(ahead - kPrefetchHits / 2, hits_.size()); prefetchedSets < last; ++prefetchedSets) {
+			const int set = frames_[shellBlock_[hits_[prefetchedSets].t]].linkedSets;
+			if (set >= 0) __builtin_prefetch(&linkedSets_[set]);
+		}
+	};
 	for (std::size_t h = 0; h < hits_.size();) {
+		prefetchUpTo(h + kPrefetchHits);
 		const int a = shellBlock_[hits_[h].s], b = shellBlock_[hits_[h].t];
 		std::size_t end = h + 1;
 		while (end < hits_.size() && shellBlock_[hits_[end].s] == a && shellBlock_[hits_[end].t] == b) ++end;
 		const Frame& fa = frames_[a];
 		const Frame& fb = frames_[b];
 		const Vector3 between = fb.origin - fa.origin;
-		const Eigen::Matrix3d inA = fa.axes * fb.dual, inB = fb.axes * fa.dual;
-		const Eigen::Matrix3d sizeInA = inA.cwiseAbs(), sizeInB = inB.cwiseAbs();
-		const Vector3 offsetInA = fa.axes * between, offsetInB = fb.axes * (-between);
+		const Eigen::Matrix3d inA = fa.axes * fb.dual;
+		const Eigen::Matrix3d sizeInA = inA.cwiseAbs();
+		const Vector3 offsetInA = fa.axes * between;
 		const double roundoff =
 		    kFrameRoundoffRelative * (between.cwiseAbs().sum() + 10 * (fa.reach + fb.reach));
-		const double limit = 2 * margin + covers_[a].widening + covers_[b].widening + roundoff;
+		const double limit = 2 * margin + fa.widening + fb.widening + roundoff;
+		// The test in b's frame is set up when first needed: in about half of
+		// the block pairs every shell pair is apart in a's frame already.
+		Eigen::Matrix3d inB, sizeInB;
+		Vector3 offsetInB;
+		bool frameB = false;
 		std::uint64_t shellsA = 0, shellsB = 0;
+		stats.shellTests += static_cast<long>(end - h);
 		for (; h < end; ++h) {
 			const int s = hits_[h].s, t = hits_[h].t;
-			++stats.shellTests;
-			if (apartInFrame(s, t, inA, sizeInA, offsetInA, limit) || apartInFrame(t, s, inB, sizeInB, offsetInB, limit))
-				continue;
+			if (apartInFrame(s, t, inA, sizeInA, offsetInA, limit)) continue;
+			if (!frameB) {
+				inB = fb.axes * fa.dual;
+				sizeInB = inB.cwiseAbs();
+				offsetInB = fb.axes * (-between);
+				frameB = true;
+			}
+			if (apartInFrame(t, s, inB, sizeInB, offsetInB, limit)) continue;
 			++stats.shellPairs;
-			shellsA |= std::uint64_t{1} << (s - covers_[a].firstShell);
-			shellsB |= std::uint64_t{1} << (t - covers_[b].firstShell);
+			shellsA |= std::uint64_t{1} << (s - fa.firstShell);
+			shellsB |= std::uint64_t{1} << (t - fb.firstShell);
 		}
 		if (shellsA) {
 			pairs.emplace_back(a, b);
@@ -713,8 +865,8 @@ std::size_t MSCCollider::memoryBytes() const {
 	                    capacityBytes(extentLow_) + capacityBytes(extentHigh_) + capacityBytes(shellBlock_) +
 	                    capacityBytes(widened_) + capacityBytes(cellLow_) + capacityBytes(cellSpan_) +
 	                    capacityBytes(cellEntries_) + capacityBytes(cellShells_) + capacityBytes(cellStart_) +
-	                    capacityBytes(oversize_) + capacityBytes(shellFixed_) +
-	                    capacityBytes(pairStart_) + capacityBytes(pairNext_) + capacityBytes(hits_) +
+	                    capacityBytes(cellScratch_) + capacityBytes(oversize_) + capacityBytes(shellFixed_) +
+	                    capacityBytes(pairStart_) + capacityBytes(hits_) +
 	                    capacityBytes(candidateSets_) + capacityBytes(linked_) + capacityBytes(linkedSets_) +
 	                    capacityBytes(lists_) + capacityBytes(listTable_) + capacityBytes(listScratch_) +
 	                    capacityBytes(searchBoxes_) + capacityBytes(cached_) + capacityBytes(kept_) +

@@ -175,9 +175,14 @@ private:
 		int firstShell = 0;    // into the flat shell arrays
 		int firstSubUnit = 0;  // into shellRanges_: its vertices, then edges, then faces
 		int vertexCount = 0, edgeCount = 0, faceCount = 0;
-		int linkedSets = -1;  // its newest set in linkedSets_ (a chain through next), -1: none
-		int linkedSetCount = 0;
+		int linkedSetCount = 0;  // its sets in linkedSets_ (the chain starts in its frame)
 		std::array<int, 3> frameFaces{-1, -1, -1};
+		// The frame faces' corners, copied from the shape so that each step
+		// reads them here rather than through the shape's face lists (three
+		// dependent cache misses per block): per face its corner count, then
+		// its corners. All zero when they do not fit (more than 256 vertices
+		// or 16 bytes): the shape's faces are read then.
+		std::array<std::uint8_t, 16> frameCorners{};
 		// Boxes and frame computed while the block was fixed (kept until it moves).
 		bool boxesBuilt = false;
 	};
@@ -185,17 +190,26 @@ private:
 	// of its vertices, edges and faces.
 	struct LinkedSet {
 		std::uint64_t shells;
-		int next;  // the block's previous set, -1: none
+		int next;  // the block's next set in its chain, -1: none
 		std::array<int, 3> lists;
 	};
 	// A block's frame at this step: rows of `axes` are unit face normals (or
 	// the coordinate axes), `dual` = axes^-1; a shell's extent is the range of
-	// axes x (p - origin) over its points p.
-	struct Frame {
-		Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();
+	// axes x (p - origin) over its points p. With the cover's widening and
+	// first shell, what the frame test and the linked sets read of a pair's
+	// second block (taken in no particular order) lies in the first two of
+	// its three cache lines.
+	struct alignas(64) Frame {
 		Eigen::Matrix3d dual = Eigen::Matrix3d::Identity();
 		Vector3 origin = Vector3::Zero();
-		double reach = 0;  // [m], largest |extent| of its shells (round-off scale)
+		double reach = 0;      // [m], largest |extent| of its shells (round-off scale)
+		double widening = 0;   // [m], its cover's
+		int firstShell = 0;    // its cover's
+		// The block's linked sets in linkedSets_, most recently used first (a
+		// chain through next), -1: none. Kept from call to call, unlike the
+		// rest, and read with the frame for the same cache lines.
+		int linkedSets = -1;
+		Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();
 	};
 	struct Override {
 		double criticalLength;
@@ -213,18 +227,21 @@ private:
 	                std::vector<int>& divisionStart) const;
 	// Lays the covers' shells out in the flat arrays (after covers changed).
 	void layoutShells();
+	// Sets cover.frameCorners from its frame faces in `shape`.
+	static void copyFrameCorners(const ConvexPolyhedron& shape, BlockCover& cover);
 	void updateBoxes(const Block& block, BlockCover& cover, Frame& frame);
-	// Grid search: every shell pair (different blocks, not both fixed) whose
-	// `boxes` meet, into `out` (unsorted); returns the box comparisons made.
-	long gridSearch(const std::vector<Block>& blocks, const std::vector<Eigen::AlignedBox3d>& boxes,
-	                std::vector<ShellPair>& out);
+	// Grid search: every shell pair (different blocks, not both fixed as
+	// shellFixed_ says) whose `boxes` meet, into `out` (unsorted); returns
+	// the box comparisons made.
+	long gridSearch(const std::vector<Eigen::AlignedBox3d>& boxes, std::vector<ShellPair>& out);
 	// Whether shells s of block a and t of block b are apart by more than
 	// `limit` [m] along an axis of a's frame (m = a.axes x b.dual, size = |m|
 	// elementwise, offset = a.axes x (b.origin - a.origin)).
 	bool apartInFrame(int s, int t, const Eigen::Matrix3d& m, const Eigen::Matrix3d& size, const Vector3& offset,
 	                  double limit) const;
-	// Sorts shell pairs by first block, then (t, s): by block pair.
-	void sortShellPairs(std::vector<ShellPair>& pairs, int blocks);
+	// Sorts shell pairs by first block, then (t, s): by block pair
+	// (`scratch`: work space, its contents lost).
+	void sortShellPairs(std::vector<ShellPair>& pairs, int blocks, std::vector<ShellPair>& scratch);
 	// Index into linkedSets_ of the block's set for `shells` (built when new).
 	int linkedSet(int block, std::uint64_t shells);
 	// Index into lists_ of a list equal to `list` (added when new).
@@ -260,13 +277,23 @@ private:
 	};
 	std::vector<Cell> cellLow_;
 	std::vector<CellSpan> cellSpan_;
-	std::vector<std::pair<std::uint64_t, int>> cellEntries_;  // sparse keys: (cell key, shell), sorted
-	std::vector<int> cellShells_;             // every cell's shells, cell after cell
+	// A cell's entry as its pairs are compared (gridSearch).
+	struct CellEntry {
+		Vector3 low, high;  // the shell's box
+		int shell, block;
+		bool fixed;
+		std::uint8_t bits;  // bits 0-2 of its entry
+	};
+	std::vector<std::pair<std::uint64_t, std::uint32_t>> cellEntries_;  // sparse keys: (cell key, entry), sorted
+	// Every cell's entries, cell after cell: shell << 3 | the axes along
+	// which the cell is the shell's lowest (bit 0: x, 1: y, 2: z).
+	std::vector<std::uint32_t> cellShells_;
+	std::vector<CellEntry> cellScratch_;      // one cell's entries (gridSearch)
 	std::vector<std::uint32_t> cellStart_;    // dense keys: where each cell's shells start
 	bool denseGrid_ = false;
 	std::vector<int> oversize_;   // shells compared with every shell
-	std::vector<char> shellFixed_;
-	std::vector<std::size_t> pairStart_, pairNext_;  // sortShellPairs' buckets
+	std::vector<char> shellFixed_;  // per flat shell, its block's fixed flag (set as boxes are updated)
+	std::vector<std::size_t> pairStart_;  // sortShellPairs' buckets
 	std::vector<ShellPair> hits_;  // the shell pairs whose d0-boxes meet, sorted
 	// Per candidate its two linked sets, until linked_ is filled.
 	std::vector<std::array<int, 2>> candidateSets_;

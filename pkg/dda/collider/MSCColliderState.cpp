@@ -101,6 +101,7 @@ void MSCCollider::readState(StateReader& in, const std::vector<Block>& blocks) {
 		const auto& ff = c.frameFaces;
 		if (!(ff[0] == -1 && ff[1] == -1 && ff[2] == -1) && !(inRange(ff[0]) && inRange(ff[1]) && inRange(ff[2])))
 			in.fail("MSC frame faces of block " + std::to_string(b) + " out of range");
+		copyFrameCorners(*blocks[b].shape, c);
 		const std::size_t shellCount = in.size(16, "MSC shells");
 		if (shellCount != static_cast<std::size_t>(c.shellCount) || c.shellCount > kMaxSegments)
 			in.fail("MSC cover of block " + std::to_string(b) + " has an inconsistent shell count");
