@@ -958,20 +958,9 @@ const char* contactTypeName(ContactType type) {
 	return "?";
 }
 
-namespace {
-// What detectInto returns: its early outs return std::nullopt (no contact),
-// as when it returned std::optional<PairContacts>; its end returns true.
-struct Detected {
-	bool found;
-	Detected(std::nullopt_t) : found(false) {}
-	Detected(bool value) : found(value) {}
-};
-}  // namespace
-
-// The bool form of detectPairContacts (the header's two forms call it).
-static Detected detectInto(const BlockGeometry& blockA, const BlockGeometry& blockB, const DetectionSettings& settings,
-                           PairContacts& out, const EntranceFeature& previous, const LinkedSubUnits* linked,
-                           NarrowPhaseWork* work) {
+bool detectPairContacts(const BlockGeometry& blockA, const BlockGeometry& blockB, const DetectionSettings& settings,
+                        PairContacts& out, const EntranceFeature& previous, const LinkedSubUnits* linked,
+                        NarrowPhaseWork* work) {
 	const double d0 = settings.contactDistance, tol = settings.lengthTolerance;
 	NarrowPhaseWork ownWork;
 	if (!work) work = &ownWork;
@@ -981,7 +970,7 @@ static Detected detectInto(const BlockGeometry& blockA, const BlockGeometry& blo
 	Prepared a = prepareBounds(blockA);
 	Prepared b = prepareBounds(blockB);
 	for (int k = 0; k < 3; ++k) {
-		if (b.lower(k) > a.upper(k) + d0 || a.lower(k) > b.upper(k) + d0) return std::nullopt;
+		if (b.lower(k) > a.upper(k) + d0 || a.lower(k) > b.upper(k) + d0) return false;
 	}
 	Scratch& s = scratch();
 	prepareFaces(a, s, 0);
@@ -997,9 +986,9 @@ static Detected detectInto(const BlockGeometry& blockA, const BlockGeometry& blo
 	{
 		const Vector3 towardsB = b.centroid - a.centroid;
 		const int fa = likelySeparatingFace(a, towardsB);
-		if (fa >= 0 && faceSeparation(a, fa, b) > d0) return std::nullopt;
+		if (fa >= 0 && faceSeparation(a, fa, b) > d0) return false;
 		const int fb = likelySeparatingFace(b, -towardsB);
-		if (fb >= 0 && faceSeparation(b, fb, a) > d0) return std::nullopt;
+		if (fb >= 0 && faceSeparation(b, fb, a) > d0) return false;
 	}
 	std::vector<FaceCandidate>& faces = s.candidates;
 	faces.clear();
@@ -1009,13 +998,13 @@ static Detected detectInto(const BlockGeometry& blockA, const BlockGeometry& blo
 	// An internal face still rejects (its plane separates), but is no entrance.
 	for (int f : a.faceList) {
 		const double sep = faceSeparation(a, f, b);
-		if (sep > d0) return std::nullopt;
+		if (sep > d0) return false;
 		deepestBound = std::max(deepestBound, sep);
 		if (!a.internal(f)) faces.push_back({{EntranceFeature::FaceOfA, f, -1}, sep});
 	}
 	for (int f : b.faceList) {
 		const double sep = faceSeparation(b, f, a);
-		if (sep > d0) return std::nullopt;
+		if (sep > d0) return false;
 		deepestBound = std::max(deepestBound, sep);
 		if (!b.internal(f)) faces.push_back({{EntranceFeature::FaceOfB, f, -1}, sep});
 	}
@@ -1055,7 +1044,7 @@ static Detected detectInto(const BlockGeometry& blockA, const BlockGeometry& blo
 			if (!(side[fb[0]] * side[fb[1]] < 0)) continue;
 			const EdgeAxis axis = edgeAxis(a, ea, b, eb, sinTolerance, side[fb[0]]);
 			if (!axis.valid) continue;
-			if (axis.separation > d0) return std::nullopt;
+			if (axis.separation > d0) return false;
 			deepestBound = std::max(deepestBound, axis.separation);
 			if (previous.kind == EntranceFeature::EdgePair && previous.feature == ea && previous.other == eb)
 				previousEdge = axis;
@@ -1155,12 +1144,6 @@ static Detected detectInto(const BlockGeometry& blockA, const BlockGeometry& blo
 	out.type = structuralType(a, featureOf(a, pointsA, featureTolerance), b, featureOf(b, pointsB, featureTolerance),
 	                          sinTolerance);
 	return true;
-}
-
-bool detectPairContacts(const BlockGeometry& blockA, const BlockGeometry& blockB, const DetectionSettings& settings,
-                        PairContacts& out, const EntranceFeature& previous, const LinkedSubUnits* linked,
-                        NarrowPhaseWork* work) {
-	return detectInto(blockA, blockB, settings, out, previous, linked, work).found;
 }
 
 std::optional<PairContacts> detectPairContacts(const BlockGeometry& blockA, const BlockGeometry& blockB,
