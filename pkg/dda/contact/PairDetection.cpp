@@ -418,13 +418,24 @@ bool arcsCross(const Prepared& a, int ea, const Prepared& b, int eb, int cba) {
 
 // Separation [m] along the outward normal of face f of `owner`: the smallest
 // signed distance of `other`'s corners from the face's plane (computed once).
-double faceSeparation(const Prepared& owner, int f, const Prepared& other) {
+//
+// With a `floor`, the corners stop at the first one below it: the result is
+// then the smallest distance of the corners so far, below `floor` and at
+// least the separation (not kept as the face's). The corners are taken in the
+// same order, so a separation at or above the floor is the same double
+// (std::min keeps the earlier of two equal values: +0 and -0 in the same
+// order). The face's plane tests are counted in full either way, so the
+// counter keeps the value it has without the floor.
+double faceSeparation(const Prepared& owner, int f, const Prepared& other,
+                      double floor = -std::numeric_limits<double>::infinity()) {
 	if (owner.separationReady[f]) return owner.separations[f];
 	ensurePlane(owner, f);
 	*owner.tests += other.cornerCount();
 	double separation = std::numeric_limits<double>::infinity();
-	for (int v = 0; v < other.cornerCount(); ++v)
+	for (int v = 0; v < other.cornerCount(); ++v) {
 		separation = std::min(separation, planeDistance(owner, f, other.corner(v)));
+		if (separation < floor) return separation;
+	}
 	owner.separations[f] = separation;
 	owner.separationReady[f] = 1;
 	return separation;
@@ -983,12 +994,38 @@ bool detectPairContacts(const BlockGeometry& blockA, const BlockGeometry& blockB
 	// 1. Face axes, stopping at the first one farther than d0. Any axis
 	// farther than d0 rejects the pair, so the likeliest separating face of
 	// each block (along the line of centroids) is tried first.
+	//
+	// A face axis far below the best face found so far is neither the
+	// entrance nor a rejection, and its exact separation is not needed: with
+	// `known` the largest separation of an entrance-eligible (non-internal)
+	// face computed in full so far, a face's corners stop once one lies below
+	// floor = known - hysteresis (faceSeparation), and the face is listed with
+	// that corner's distance p, floor > p >= its separation. Every use of the
+	// list then decides as with the separation (rounding is monotone:
+	// fl(x - y) grows with x and falls with y; hysteresis >= tol; and known <=
+	// bestFace <= best below): p cannot reject (p < known <= d0, and a face
+	// with a corner below d0 does not reject either), cannot raise
+	// deepestBound or bestFace (p < known, itself in both), is not the kept
+	// previous face (p < fl(known - hysteresis) <= fl(best - hysteresis)) and
+	// is passed over by chooseFace (p < fl(bestFace - tol)), as is any
+	// separation below p. A face that rejects has every corner above d0 >=
+	// known, hence above the floor, and is computed in full.
+	const double hysteresis = std::max(settings.hysteresis, tol);
+	double known = -std::numeric_limits<double>::infinity();
 	{
 		const Vector3 towardsB = b.centroid - a.centroid;
 		const int fa = likelySeparatingFace(a, towardsB);
-		if (fa >= 0 && faceSeparation(a, fa, b) > d0) return false;
+		if (fa >= 0) {
+			const double sep = faceSeparation(a, fa, b);
+			if (sep > d0) return false;
+			if (!a.internal(fa)) known = sep;
+		}
 		const int fb = likelySeparatingFace(b, -towardsB);
-		if (fb >= 0 && faceSeparation(b, fb, a) > d0) return false;
+		if (fb >= 0) {
+			const double sep = faceSeparation(b, fb, a);
+			if (sep > d0) return false;
+			if (!b.internal(fb)) known = std::max(known, sep);
+		}
 	}
 	std::vector<FaceCandidate>& faces = s.candidates;
 	faces.clear();
@@ -997,16 +1034,20 @@ bool detectPairContacts(const BlockGeometry& blockA, const BlockGeometry& blockB
 	double deepestBound = -std::numeric_limits<double>::infinity();
 	// An internal face still rejects (its plane separates), but is no entrance.
 	for (int f : a.faceList) {
-		const double sep = faceSeparation(a, f, b);
+		const double sep = faceSeparation(a, f, b, known - hysteresis);
 		if (sep > d0) return false;
 		deepestBound = std::max(deepestBound, sep);
-		if (!a.internal(f)) faces.push_back({{EntranceFeature::FaceOfA, f, -1}, sep});
+		if (a.internal(f)) continue;
+		faces.push_back({{EntranceFeature::FaceOfA, f, -1}, sep});
+		known = std::max(known, sep);
 	}
 	for (int f : b.faceList) {
-		const double sep = faceSeparation(b, f, a);
+		const double sep = faceSeparation(b, f, a, known - hysteresis);
 		if (sep > d0) return false;
 		deepestBound = std::max(deepestBound, sep);
-		if (!b.internal(f)) faces.push_back({{EntranceFeature::FaceOfB, f, -1}, sep});
+		if (b.internal(f)) continue;
+		faces.push_back({{EntranceFeature::FaceOfB, f, -1}, sep});
+		known = std::max(known, sep);
 	}
 	double bestFace = -std::numeric_limits<double>::infinity();
 	for (const FaceCandidate& c : faces) bestFace = std::max(bestFace, c.separation);
@@ -1066,7 +1107,6 @@ bool detectPairContacts(const BlockGeometry& blockA, const BlockGeometry& blockB
 	}
 
 	// 2. The entrance feature.
-	const double hysteresis = std::max(settings.hysteresis, tol);
 	EntranceFeature entrance;
 	double separation = 0;
 	if (previous.kind == EntranceFeature::EdgePair && previousEdge.valid &&
