@@ -33,7 +33,7 @@ ContactStencil edgeEdgeStencil(const Vector3& p1, const Vector3& p2, const Vecto
 	return s;
 }
 
-std::array<int, 3> chooseFaceCorners(const std::vector<Vector3>& vertices, const std::vector<int>& face) {
+FaceTriangle chooseFaceTriangle(const std::vector<Vector3>& vertices, const std::vector<int>& face) {
 	const std::size_t m = face.size();
 	if (m < 3) throw InputError("a face needs at least 3 corners, got " + std::to_string(m));
 	for (int v : face) {
@@ -42,21 +42,41 @@ std::array<int, 3> chooseFaceCorners(const std::vector<Vector3>& vertices, const
 			                 std::to_string(vertices.size()) + " vertices");
 		}
 	}
-	std::array<int, 3> best{face[0], face[1], face[2]};
-	double bestArea = -1;
+	FaceTriangle out;
+	out.corners = {face[0], face[1], face[2]};
+	// Largest |cross|, the first of equal ones. |cross| = sqrt(squared) is
+	// taken only for a triangle whose squared norm is above the best's: sqrt
+	// rounds monotonically, so any other has |cross| <= the best's and would
+	// not replace it (NaN compares false both ways), as with every norm taken.
+	double bestNorm = -1, bestSquared = -1;
 	for (std::size_t a = 0; a < m; ++a) {
 		for (std::size_t b = a + 1; b < m; ++b) {
 			for (std::size_t c = b + 1; c < m; ++c) {
 				const Vector3& pa = vertices[face[a]];
-				const double area = (vertices[face[b]] - pa).cross(vertices[face[c]] - pa).norm();
-				if (area > bestArea) {
-					bestArea = area;
-					best = {face[a], face[b], face[c]};  // a < b < c keeps the cyclic order
+				const Vector3 cross = (vertices[face[b]] - pa).cross(vertices[face[c]] - pa);
+				const double squared = cross.squaredNorm();
+				const bool first = c == 2;  // a, b, c = 0, 1, 2
+				if (!first && !(squared > bestSquared)) continue;
+				const double norm = std::sqrt(squared);  // cross.norm()
+				if (first) {  // also the triangle's (corners) cross when none is chosen (NaN)
+					out.firstCross = out.cross = cross;
+					out.firstCrossNorm = out.crossNorm = norm;
+				}
+				if (norm > bestNorm) {
+					bestNorm = norm;
+					bestSquared = squared;
+					out.corners = {face[a], face[b], face[c]};  // a < b < c keeps the cyclic order
+					out.cross = cross;
+					out.crossNorm = norm;
 				}
 			}
 		}
 	}
-	return best;
+	return out;
+}
+
+std::array<int, 3> chooseFaceCorners(const std::vector<Vector3>& vertices, const std::vector<int>& face) {
+	return chooseFaceTriangle(vertices, face).corners;
 }
 
 double stencilDeterminant(const std::array<Vector3, 4>& q) {

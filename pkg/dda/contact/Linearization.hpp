@@ -81,6 +81,18 @@ ContactStencil edgeEdgeStencil(const Vector3& p1, const Vector3& p2, const Vecto
 // Throws InputError for fewer than 3 corners or an index out of range.
 std::array<int, 3> chooseFaceCorners(const std::vector<Vector3>& vertices, const std::vector<int>& face);
 
+// chooseFaceCorners' triangle with cross products it computes on the way (the
+// same doubles as computing them again): (f1 - f0) x (f2 - f0) of the chosen
+// triangle and of the face's first three corners, and their norms.
+struct FaceTriangle {
+	std::array<int, 3> corners{};
+	Vector3 cross = Vector3::Zero();       // [m^2]
+	double crossNorm = 0;                  // [m^2]
+	Vector3 firstCross = Vector3::Zero();  // [m^2]
+	double firstCrossNorm = 0;             // [m^2]
+};
+FaceTriangle chooseFaceTriangle(const std::vector<Vector3>& vertices, const std::vector<int>& face);
+
 // Delta = det [[1, Q1], [1, Q2], [1, Q3], [1, Q4]] [m^3].
 double stencilDeterminant(const std::array<Vector3, 4>& q);
 // S of the stencil's kind [m^2].

@@ -73,20 +73,26 @@ constexpr double kCrossRoundoffRelative = 1e-14;
 ExactPoint exactPoint(const Vector3& p) { return ExactPoint(p.x(), p.y(), p.z()); }
 ExactVector exactVector(const Vector3& v) { return ExactVector(v.x(), v.y(), v.z()); }
 
-// Face f's plane (FacePlane without firstNormal/firstNorm). Both the per-call
-// path (ensurePlane) and BlockPlanes::compute use this one function, so a
-// cached plane holds the same doubles as one built per call.
-void buildFacePlane(const std::vector<Vector3>& v, const std::vector<int>& face, FacePlane& plane) {
-	plane.corners = chooseFaceCorners(v, face);
+// Face f's plane (FacePlane without firstNormal/firstNorm, which the returned
+// triangle holds). Both the per-call path (ensurePlane) and
+// BlockPlanes::compute use this one function, so a cached plane holds the
+// same doubles as one built per call.
+FaceTriangle buildFacePlane(const std::vector<Vector3>& v, const std::vector<int>& face, FacePlane& plane) {
+	const FaceTriangle triangle = chooseFaceTriangle(v, face);
+	plane.corners = triangle.corners;
 	const Vector3& f0 = v[plane.corners[0]];
-	const Vector3 cross = (v[plane.corners[1]] - f0).cross(v[plane.corners[2]] - f0);
-	plane.normal = cross.normalized();
+	// The triangle's (f1 - f0) x (f2 - f0), normalized as Eigen's normalized()
+	// does: divided by its norm, sqrt(squaredNorm()), when that is > 0 (as the
+	// squared norm then is), else unchanged.
+	plane.normal = triangle.crossNorm > 0 ? Vector3(triangle.cross / triangle.crossNorm) : triangle.cross;
 	plane.side1 = (v[plane.corners[1]] - f0).norm();
 	plane.side2 = (v[plane.corners[2]] - f0).norm();
+	return triangle;
 }
 
 // The normal of a face's first three corners (unnormalised), scored by
-// likelySeparatingFace.
+// likelySeparatingFace: (v1 - v0) x (v2 - v0), the triangle chooseFaceTriangle
+// tries first (its firstCross).
 Vector3 firstCornersNormal(const std::vector<Vector3>& v, const std::vector<int>& face) {
 	const Vector3& f0 = v[face[0]];
 	return (v[face[1]] - f0).cross(v[face[2]] - f0);
@@ -946,9 +952,9 @@ void BlockPlanes::compute(const ConvexPolyhedron& shape, const std::vector<Vecto
 	faces.resize(faceCount);
 	for (int f = 0; f < faceCount; ++f) {
 		FacePlane& plane = faces[f];
-		buildFacePlane(vertices, shape.faces[f], plane);
-		plane.firstNormal = firstCornersNormal(vertices, shape.faces[f]);
-		plane.firstNorm = plane.firstNormal.norm();
+		const FaceTriangle triangle = buildFacePlane(vertices, shape.faces[f], plane);
+		plane.firstNormal = triangle.firstCross;  // firstCornersNormal
+		plane.firstNorm = triangle.firstCrossNorm;
 	}
 	const int edgeCount = static_cast<int>(shape.edges.size());
 	edges.resize(edgeCount);
