@@ -366,6 +366,8 @@ BOOST_PYTHON_MODULE(_core) {
 	    .def("initialOverlaps", &initialOverlaps)
 	    .def("collider", &colliderName)
 	    .def("linkBody", &linkBody)
+	    .def("reserveBlocks", &SceneLink::reserveBlocks, py::arg("extra"),
+	         "Room for extra more blocks (and their body links), added next one by one.")
 	    .def("blockOfBody", &bodyToBlock)
 	    .def("blockCount", &SceneLink::blockCount)
 	    .def("vertices", &blockVertices)

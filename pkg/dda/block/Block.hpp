@@ -56,7 +56,9 @@ struct Block {
 	Vector6 stress = Vector6::Zero();      // (sxx, syy, szz, sxy, syz, szx) [Pa]
 	Vector6 strain = Vector6::Zero();      // accumulated (ex, ey, ez, gxy, gyz, gzx) [-]
 	Material material;
-	Matrix6 elasticity = Matrix6::Zero();  // of the material [Pa]
+	// Elasticity matrix of the material [Pa]. Computed when asked (a dozen
+	// flops) rather than stored: 288 bytes per block, 14 MB on 50,000 blocks.
+	Matrix6 elasticity() const { return elasticityMatrix(material.young, material.poisson); }
 	bool fixed = false;  // a fixed block has no unknowns: it never moves
 	// A rigid block has 6 unknowns (translation, rotation): no strain, no
 	// stress, no elastic term. Its strain unknowns and rates stay exactly zero

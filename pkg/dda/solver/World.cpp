@@ -191,6 +191,11 @@ int World::addBlock(const std::vector<Vector3>& points, const Material& material
 	return blockCount() - 1;
 }
 
+void World::reserveBlocks(int extra) {
+	const std::size_t needed = blocks_.size() + static_cast<std::size_t>(std::max(extra, 0));
+	if (needed > blocks_.capacity()) blocks_.reserve(std::max(needed, 2 * blocks_.size()));
+}
+
 Block makeBlock(const std::vector<Vector3>& points, const Material& material, bool fixed, bool rigid) {
 	validateMaterial(material);
 	auto shape = std::make_shared<const ConvexPolyhedron>(buildConvexPolyhedron(points));
@@ -204,7 +209,6 @@ Block makeBlock(const std::vector<Vector3>& points, const Material& material, bo
 	block.mass = material.density * properties.volume;
 	block.size = std::cbrt(properties.volume);
 	block.material = material;
-	block.elasticity = elasticityMatrix(material.young, material.poisson);
 	block.fixed = fixed;
 	block.rigid = rigid;
 	return block;

@@ -68,7 +68,7 @@ void writeBlock(StateWriter& out, const Block& b) {
 	out.matrix(b.strain);
 	const Material& m = b.material;
 	for (double x : {m.density, m.young, m.poisson, m.frictionAngle, m.cohesion, m.tensileStrength}) out.pod(x);
-	out.matrix(b.elasticity);
+	out.matrix(b.elasticity());  // kept in the format; read back only as a check
 	out.pod(static_cast<std::uint8_t>(b.fixed));
 	out.pod(static_cast<std::uint8_t>(b.rigid));
 	out.size(b.fixedPoints.size());
@@ -101,7 +101,12 @@ Block readBlock(StateReader& in) {
 	in.matrix(b.strain);
 	Material& m = b.material;
 	for (double* x : {&m.density, &m.young, &m.poisson, &m.frictionAngle, &m.cohesion, &m.tensileStrength}) in.pod(*x);
-	in.matrix(b.elasticity);
+	// The block holds no elasticity matrix (Block::elasticity computes it from
+	// the material); the one saved must be that one, or the restored block
+	// would not continue as the saved one.
+	Matrix6 elasticity;
+	in.matrix(elasticity);
+	if (elasticity != b.elasticity()) in.fail("a block's elasticity matrix does not follow from its young and poisson");
 	b.fixed = in.pod<std::uint8_t>() != 0;
 	b.rigid = in.pod<std::uint8_t>() != 0;
 	b.fixedPoints.resize(in.size(7 * sizeof(double), "fixed points"));
