@@ -45,7 +45,10 @@ struct PointLoad {
 };
 
 struct Block {
-	std::shared_ptr<const ConvexPolyhedron> shape;  // topology; vertices as created
+	// Faces and edges, shared with the other blocks of the same topology
+	// (World interns them, see TopologyPool).
+	std::shared_ptr<const PolyhedronTopology> shape;
+	std::vector<Vector3> initialVertices;           // as created [m]; saved, read by no step
 	std::vector<Vector3> vertices;                  // current positions [m]
 	Vector3 centroid = Vector3::Zero();             // [m]
 	double volume = 0;                              // [m^3]

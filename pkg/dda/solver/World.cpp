@@ -187,7 +187,9 @@ DetectionSettings pairDetectionSettings(double diagonalA, double diagonalB, doub
 }
 
 int World::addBlock(const std::vector<Vector3>& points, const Material& material, bool fixed, bool rigid) {
-	blocks_.push_back(makeBlock(points, material, fixed, rigid));
+	Block block = makeBlock(points, material, fixed, rigid);
+	block.shape = topologies_.intern(std::move(block.shape));
+	blocks_.push_back(std::move(block));
 	return blockCount() - 1;
 }
 
@@ -198,11 +200,12 @@ void World::reserveBlocks(int extra) {
 
 Block makeBlock(const std::vector<Vector3>& points, const Material& material, bool fixed, bool rigid) {
 	validateMaterial(material);
-	auto shape = std::make_shared<const ConvexPolyhedron>(buildConvexPolyhedron(points));
-	const MassProperties properties = computeMassProperties(shape->vertices, shape->faces);
+	ConvexPolyhedron polyhedron = buildConvexPolyhedron(points);
+	const MassProperties properties = computeMassProperties(polyhedron.vertices, polyhedron.faces);
 	Block block;
-	block.shape = shape;
-	block.vertices = shape->vertices;
+	block.vertices = polyhedron.vertices;
+	block.initialVertices = std::move(polyhedron.vertices);
+	block.shape = std::make_shared<const PolyhedronTopology>(std::move(static_cast<PolyhedronTopology&>(polyhedron)));
 	block.centroid = properties.centroid;
 	block.volume = properties.volume;
 	block.secondMoment = properties.secondMoment;

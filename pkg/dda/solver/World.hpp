@@ -152,6 +152,7 @@ private:
 	std::vector<int> blockUnknowns_;  // per moving block: 12, or 6 when rigid
 	long aloneUnknowns_ = 0;          // of the moving blocks left out of coupled_
 	std::vector<Block> blocks_;
+	TopologyPool topologies_;  // the blocks' shared topologies
 	StepStatistics stats_;
 	double nextTimeStep_ = 0;  // dt to try first in the next step; 0 = maxTimeStep
 	double time_ = 0;
