@@ -32,6 +32,11 @@ void SceneLink::link(int blockIndex, int bodyId, const Eigen::Quaterniond& orien
 	blockOfBody_[bodyId] = blockIndex;
 }
 
+void SceneLink::reserveBlocks(int extra) {
+	world.reserveBlocks(extra);
+	links_.reserve(world.blockCapacity());
+}
+
 const BodyLink* SceneLink::bodyLink(int blockIndex) const {
 	if (blockIndex < 0 || blockIndex >= static_cast<int>(links_.size()) || links_[blockIndex].bodyId < 0) return nullptr;
 	return &links_[blockIndex];

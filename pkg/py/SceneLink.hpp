@@ -40,6 +40,8 @@ public:
 	Eigen::Quaterniond bodyOrientation(int block) const;
 	std::vector<Vector3> localVertices(int block) const;
 
+	// World::reserveBlocks, and as much room in the body links.
+	void reserveBlocks(int extra);
 	int blockCount() const { return world.blockCount(); }
 	double sceneHalfSize() { return world.sceneHalfSize(); }
 	double time() const { return world.time(); }

@@ -41,6 +41,7 @@ class DDAScene:
         if not self.pending:
             return
         waiting = []
+        self.core.reserveBlocks(len(self.pending))    # one allocation for the batch, sized to it
         for body, spec in self.pending:
             if body.id < 0:
                 waiting.append((body, spec))   # made but not (yet) appended: not simulated

@@ -69,6 +69,26 @@ TEST(WorldState, RestoredWorldContinuesBitwise) {
 	EXPECT_TRUE(closed);
 }
 
+// Blocks of equal faces and edges share one topology (TopologyPool), in a
+// world built block by block and in one restored from its state; a block of
+// another topology has its own.
+TEST(WorldState, BlocksOfOneTopologyShareIt) {
+	World world = settlingStack();
+	world.addBlock({{5, 5, 0}, {6, 5, 0}, {5, 6, 0}, {5, 5, 1}}, Material{}, true);
+	for (int b = 1; b < 4; ++b) EXPECT_EQ(world.block(b).shape, world.block(0).shape) << "block " << b;
+	EXPECT_NE(world.block(4).shape, world.block(0).shape);
+	EXPECT_EQ(world.block(0).shape->vertexCount(), 8);
+	EXPECT_EQ(world.block(4).shape->vertexCount(), 4);
+	const std::string saved = stateOf(world);
+	World restored;
+	StateReader in(saved);
+	restored.readState(in);
+	for (int b = 1; b < 4; ++b) EXPECT_EQ(restored.block(b).shape, restored.block(0).shape) << "block " << b;
+	EXPECT_NE(restored.block(4).shape, restored.block(0).shape);
+	EXPECT_TRUE(*restored.block(4).shape == *world.block(4).shape);
+	EXPECT_TRUE(stateOf(restored) == saved);
+}
+
 TEST(WorldState, BadStateThrowsAndChangesNothing) {
 	World world = settlingStack();
 	for (int k = 0; k < 5; ++k) world.step(settings());

@@ -45,7 +45,10 @@ struct PointLoad {
 };
 
 struct Block {
-	std::shared_ptr<const ConvexPolyhedron> shape;  // topology; vertices as created
+	// Faces and edges, shared with the other blocks of the same topology
+	// (World interns them, see TopologyPool).
+	std::shared_ptr<const PolyhedronTopology> shape;
+	std::vector<Vector3> initialVertices;           // as created [m]; saved, read by no step
 	std::vector<Vector3> vertices;                  // current positions [m]
 	Vector3 centroid = Vector3::Zero();             // [m]
 	double volume = 0;                              // [m^3]
@@ -56,7 +59,9 @@ struct Block {
 	Vector6 stress = Vector6::Zero();      // (sxx, syy, szz, sxy, syz, szx) [Pa]
 	Vector6 strain = Vector6::Zero();      // accumulated (ex, ey, ez, gxy, gyz, gzx) [-]
 	Material material;
-	Matrix6 elasticity = Matrix6::Zero();  // of the material [Pa]
+	// Elasticity matrix of the material [Pa]. Computed when asked (a dozen
+	// flops) rather than stored: 288 bytes per block, 14 MB on 50,000 blocks.
+	Matrix6 elasticity() const { return elasticityMatrix(material.young, material.poisson); }
 	bool fixed = false;  // a fixed block has no unknowns: it never moves
 	// A rigid block has 6 unknowns (translation, rotation): no strain, no
 	// stress, no elastic term. Its strain unknowns and rates stay exactly zero

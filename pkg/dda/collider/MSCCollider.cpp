@@ -147,7 +147,7 @@ const Eigen::AlignedBox3d& MSCCollider::shellBox(int block, int shell) const {
 void MSCCollider::buildCover(const Block& block, double criticalLength, int segments, BlockCover& cover,
                              std::vector<ShellRange>& shellRanges, std::vector<DivisionPoint>& divisions,
                              std::vector<int>& divisionStart) const {
-	const ConvexPolyhedron& shape = *block.shape;
+	const PolyhedronTopology& shape = *block.shape;
 	const std::vector<Vector3>& x = block.vertices;
 	const int nv = static_cast<int>(x.size());
 	const int ne = static_cast<int>(shape.edges.size());
@@ -246,9 +246,9 @@ void MSCCollider::buildCover(const Block& block, double criticalLength, int segm
 	}
 }
 
-void MSCCollider::copyFrameCorners(const ConvexPolyhedron& shape, BlockCover& cover) {
+void MSCCollider::copyFrameCorners(const PolyhedronTopology& shape, BlockCover& cover) {
 	cover.frameCorners.fill(0);
-	if (cover.frameFaces[0] < 0 || shape.vertices.size() > 256) return;
+	if (cover.frameFaces[0] < 0 || shape.vertexCount() > 256) return;
 	std::size_t used = 0;
 	for (const int f : cover.frameFaces) used += 1 + shape.faces[f].size();
 	if (used > cover.frameCorners.size()) return;
@@ -260,7 +260,7 @@ void MSCCollider::copyFrameCorners(const ConvexPolyhedron& shape, BlockCover& co
 }
 
 void MSCCollider::updateBoxes(const Block& block, BlockCover& cover, Frame& frame) {
-	const ConvexPolyhedron& shape = *block.shape;
+	const PolyhedronTopology& shape = *block.shape;
 	const std::vector<Vector3>& x = block.vertices;
 	// The frame.
 	frame.axes.setIdentity();

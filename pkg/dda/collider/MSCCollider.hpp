@@ -167,7 +167,10 @@ private:
 	struct BlockCover {
 		// The cover is rebuilt when the block's shape changes (held: its
 		// address is not reused, and saving finds division points' edges in it).
-		std::shared_ptr<const ConvexPolyhedron> shape;
+		// Blocks of one topology share one shape (TopologyPool), so this sees
+		// a change of topology only; a world replaces its blocks only when it
+		// reads a state, and then it has a new collider too.
+		std::shared_ptr<const PolyhedronTopology> shape;
 		double criticalLength = 0;                // [m], as built
 		double widening = 0;                      // [m]: kShellWideningRelative x diagonal
 		int segments = 0;                         // as asked (used when the block is long)
@@ -228,7 +231,7 @@ private:
 	// Lays the covers' shells out in the flat arrays (after covers changed).
 	void layoutShells();
 	// Sets cover.frameCorners from its frame faces in `shape`.
-	static void copyFrameCorners(const ConvexPolyhedron& shape, BlockCover& cover);
+	static void copyFrameCorners(const PolyhedronTopology& shape, BlockCover& cover);
 	void updateBoxes(const Block& block, BlockCover& cover, Frame& frame);
 	// Grid search: every shell pair (different blocks, not both fixed as
 	// shellFixed_ says) whose `boxes` meet, into `out` (unsorted); returns

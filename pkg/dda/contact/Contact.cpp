@@ -13,7 +13,7 @@ std::uint64_t pairKey(int a, int b) {
 }
 
 // Faces f and g of a shape share an edge.
-bool facesAdjacent(const ConvexPolyhedron& shape, int f, int g) {
+bool facesAdjacent(const PolyhedronTopology& shape, int f, int g) {
 	for (const auto& faces : shape.edgeFaces)
 		if ((faces[0] == f && faces[1] == g) || (faces[0] == g && faces[1] == f)) return true;
 	return false;
@@ -25,7 +25,7 @@ bool sameFeature1(const ContactKey& a, const ContactKey& b) {
 }
 
 // Edges e and g of a shape share a corner.
-bool edgesAdjacent(const ConvexPolyhedron& shape, int e, int g) {
+bool edgesAdjacent(const PolyhedronTopology& shape, int e, int g) {
 	const auto& a = shape.edges[e];
 	const auto& b = shape.edges[g];
 	return a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1];
@@ -94,7 +94,7 @@ int ContactStore::firstWithFeature1(const ContactKey& key) const {
 }
 
 Contact& ContactStore::add(const ContactKey& key, ContactType pairType, const SubContact& geometry,
-                           const ConvexPolyhedron& shapeI, const ConvexPolyhedron& shapeJ) {
+                           const PolyhedronTopology& shapeI, const PolyhedronTopology& shapeJ) {
 	(void)shapeI;
 	Contact& contact = current_.emplace_back();
 	contact.key = key;

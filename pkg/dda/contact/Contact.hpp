@@ -91,7 +91,7 @@ public:
 	// (same identity, else a neighbour as described above). `shapeI`/`shapeJ`
 	// give the topology for the neighbour search.
 	Contact& add(const ContactKey& key, ContactType pairType, const SubContact& geometry,
-	             const ConvexPolyhedron& shapeI, const ConvexPolyhedron& shapeJ);
+	             const PolyhedronTopology& shapeI, const PolyhedronTopology& shapeJ);
 	std::vector<Contact>& contacts() { return current_; }
 	const std::vector<Contact>& contacts() const { return current_; }
 

@@ -99,7 +99,7 @@ Vector3 firstCornersNormal(const std::vector<Vector3>& v, const std::vector<int>
 }
 
 // Edge e's data from its corners and its faces' planes (shared as above).
-void buildEdge(const std::vector<Vector3>& v, const ConvexPolyhedron& shape, const FacePlane* faces, int e,
+void buildEdge(const std::vector<Vector3>& v, const PolyhedronTopology& shape, const FacePlane* faces, int e,
                EdgeData& d) {
 	d.direction = v[shape.edges[e][1]] - v[shape.edges[e][0]];
 	d.length = d.direction.norm();
@@ -169,7 +169,7 @@ struct Indices {
 
 // A block with the per-call data the narrow phase needs.
 struct Prepared {
-	const ConvexPolyhedron* shape = nullptr;
+	const PolyhedronTopology* shape = nullptr;
 	const std::vector<Vector3>* vertices = nullptr;
 	Vector3 centroid = Vector3::Zero();
 	// Face planes: the block's BlockPlanes (every plane built), or the
@@ -960,7 +960,7 @@ bool previousLinked(const Prepared& a, const Prepared& b, const EntranceFeature&
 
 }  // namespace
 
-void BlockPlanes::compute(const ConvexPolyhedron& shape, const std::vector<Vector3>& vertices) {
+void BlockPlanes::compute(const PolyhedronTopology& shape, const std::vector<Vector3>& vertices) {
 	const int faceCount = static_cast<int>(shape.faces.size());
 	faces.resize(faceCount);
 	for (int f = 0; f < faceCount; ++f) {

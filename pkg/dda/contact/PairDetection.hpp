@@ -137,12 +137,12 @@ struct BlockPlanes {
 	std::vector<FacePlane> faces;
 	std::vector<EdgeData> edges;
 	Vector3 lower = Vector3::Zero(), upper = Vector3::Zero();  // bounding box of the corners [m]
-	void compute(const ConvexPolyhedron& shape, const std::vector<Vector3>& vertices);
+	void compute(const PolyhedronTopology& shape, const std::vector<Vector3>& vertices);
 };
 
 // A block as the narrow phase sees it: current corners [m] and topology.
 struct BlockGeometry {
-	const ConvexPolyhedron* shape = nullptr;       // faces, edges, edgeFaces
+	const PolyhedronTopology* shape = nullptr;     // faces, edges, edgeFaces
 	const std::vector<Vector3>* vertices = nullptr;  // current corners [m]
 	Vector3 centroid = Vector3::Zero();            // [m]
 	// Optional, per face: 1 for a face fully covered by a coplanar, opposed

@@ -42,10 +42,10 @@ struct LinkedSubUnits {
 };
 
 // The sub-unit loops of a pair when every sub-unit takes part.
-inline long allSubUnitPairs(const ConvexPolyhedron& a, const ConvexPolyhedron& b) {
-	const auto v = [](const ConvexPolyhedron& s) { return static_cast<long>(s.vertices.size()); };
-	const auto e = [](const ConvexPolyhedron& s) { return static_cast<long>(s.edges.size()); };
-	const auto f = [](const ConvexPolyhedron& s) { return static_cast<long>(s.faces.size()); };
+inline long allSubUnitPairs(const PolyhedronTopology& a, const PolyhedronTopology& b) {
+	const auto v = [](const PolyhedronTopology& s) { return static_cast<long>(s.vertexCount()); };
+	const auto e = [](const PolyhedronTopology& s) { return static_cast<long>(s.edges.size()); };
+	const auto f = [](const PolyhedronTopology& s) { return static_cast<long>(s.faces.size()); };
 	return v(a) * f(b) + v(b) * f(a) + e(a) * e(b);
 }
 

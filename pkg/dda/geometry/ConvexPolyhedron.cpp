@@ -583,4 +583,20 @@ ConvexPolyhedron buildConvexPolyhedron(const std::vector<Vector3>& points) {
 	return poly;
 }
 
+std::shared_ptr<const PolyhedronTopology> TopologyPool::intern(std::shared_ptr<const PolyhedronTopology> topology) {
+	std::size_t hash = topology->faces.size();
+	const auto mix = [&hash](int x) { hash = hash * 1000003u ^ static_cast<std::size_t>(x); };
+	for (const auto& face : topology->faces) {
+		mix(static_cast<int>(face.size()));
+		for (int v : face) mix(v);
+	}
+	for (const auto& edge : topology->edges) mix(edge[0]), mix(edge[1]);
+	for (const auto& faces : topology->edgeFaces) mix(faces[0]), mix(faces[1]);
+	const auto [first, last] = byHash_.equal_range(hash);
+	for (auto it = first; it != last; ++it)
+		if (*it->second == *topology) return it->second;
+	byHash_.emplace(hash, topology);
+	return topology;
+}
+
 }  // namespace dda

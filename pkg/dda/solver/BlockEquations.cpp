@@ -16,7 +16,7 @@ void assembleBlock(const Block& block, const IntegratorSettings& settings, doubl
 	system.stiffness.noalias() = (2 / (dt * dt)) * mass;
 	system.force.noalias() = (2 / dt) * (mass * v0);
 
-	system.stiffness.block<6, 6>(6, 6).noalias() += block.volume * block.elasticity;
+	system.stiffness.block<6, 6>(6, 6).noalias() += block.volume * block.elasticity();
 	system.force.segment<6>(6).noalias() -= block.volume * block.stress;
 
 	if (!settings.gravity.isZero()) system.force.head<3>() += block.mass * settings.gravity;
@@ -135,7 +135,7 @@ void applyStep(Block& block, const Vector12& D, const Vector12& v0, double dt) {
 	block.velocity = velocity;
 
 	const Vector6 strainIncrement = D.segment<6>(6);
-	block.stress = stressVoigt(rotation * stressTensor(block.stress) * rotation.transpose()) + block.elasticity * strainIncrement;
+	block.stress = stressVoigt(rotation * stressTensor(block.stress) * rotation.transpose()) + block.elasticity() * strainIncrement;
 	block.strain = strainVoigt(rotation * strainTensor(block.strain) * rotation.transpose()) + strainIncrement;
 	block.unsyncedStrain += strainIncrement.norm();
 }

@@ -187,24 +187,31 @@ DetectionSettings pairDetectionSettings(double diagonalA, double diagonalB, doub
 }
 
 int World::addBlock(const std::vector<Vector3>& points, const Material& material, bool fixed, bool rigid) {
-	blocks_.push_back(makeBlock(points, material, fixed, rigid));
+	Block block = makeBlock(points, material, fixed, rigid);
+	block.shape = topologies_.intern(std::move(block.shape));
+	blocks_.push_back(std::move(block));
 	return blockCount() - 1;
+}
+
+void World::reserveBlocks(int extra) {
+	const std::size_t needed = blocks_.size() + static_cast<std::size_t>(std::max(extra, 0));
+	if (needed > blocks_.capacity()) blocks_.reserve(std::max(needed, 2 * blocks_.size()));
 }
 
 Block makeBlock(const std::vector<Vector3>& points, const Material& material, bool fixed, bool rigid) {
 	validateMaterial(material);
-	auto shape = std::make_shared<const ConvexPolyhedron>(buildConvexPolyhedron(points));
-	const MassProperties properties = computeMassProperties(shape->vertices, shape->faces);
+	ConvexPolyhedron polyhedron = buildConvexPolyhedron(points);
+	const MassProperties properties = computeMassProperties(polyhedron.vertices, polyhedron.faces);
 	Block block;
-	block.shape = shape;
-	block.vertices = shape->vertices;
+	block.vertices = polyhedron.vertices;
+	block.initialVertices = std::move(polyhedron.vertices);
+	block.shape = std::make_shared<const PolyhedronTopology>(std::move(static_cast<PolyhedronTopology&>(polyhedron)));
 	block.centroid = properties.centroid;
 	block.volume = properties.volume;
 	block.secondMoment = properties.secondMoment;
 	block.mass = material.density * properties.volume;
 	block.size = std::cbrt(properties.volume);
 	block.material = material;
-	block.elasticity = elasticityMatrix(material.young, material.poisson);
 	block.fixed = fixed;
 	block.rigid = rigid;
 	return block;

@@ -25,8 +25,8 @@ namespace {
 // StepStatistics is the same (else left zero; nothing later depends on them).
 static_assert(std::is_trivially_copyable_v<StepStatistics>);
 
-void writeShape(StateWriter& out, const ConvexPolyhedron& shape) {
-	out.matrixVector(shape.vertices);
+void writeShape(StateWriter& out, const std::vector<Vector3>& vertices, const PolyhedronTopology& shape) {
+	out.matrixVector(vertices);
 	out.size(shape.faces.size());
 	for (const auto& face : shape.faces) out.podVector(face);
 	out.podVector(shape.edges);
@@ -48,6 +48,8 @@ ConvexPolyhedron readShape(StateReader& in) {
 	in.podVector(shape.edgeFaces, "edge faces");
 	const int nf = static_cast<int>(shape.faces.size());
 	if (shape.edgeFaces.size() != shape.edges.size()) in.fail("edges and edge faces differ in number");
+	// PolyhedronTopology::vertexCount counts on it (as buildConvexPolyhedron checks).
+	if (shape.vertexCount() != nv) in.fail("a block's vertices, edges and faces fail Euler's formula V - E + F = 2");
 	for (std::size_t e = 0; e < shape.edges.size(); ++e)
 		for (int k = 0; k < 2; ++k)
 			if (shape.edges[e][k] < 0 || shape.edges[e][k] >= nv || shape.edgeFaces[e][k] < 0 || shape.edgeFaces[e][k] >= nf)
@@ -56,7 +58,7 @@ ConvexPolyhedron readShape(StateReader& in) {
 }
 
 void writeBlock(StateWriter& out, const Block& b) {
-	writeShape(out, *b.shape);
+	writeShape(out, b.initialVertices, *b.shape);
 	out.matrixVector(b.vertices);
 	out.matrix(b.centroid);
 	out.pod(b.volume);
@@ -68,7 +70,7 @@ void writeBlock(StateWriter& out, const Block& b) {
 	out.matrix(b.strain);
 	const Material& m = b.material;
 	for (double x : {m.density, m.young, m.poisson, m.frictionAngle, m.cohesion, m.tensileStrength}) out.pod(x);
-	out.matrix(b.elasticity);
+	out.matrix(b.elasticity());  // kept in the format; read back only as a check
 	out.pod(static_cast<std::uint8_t>(b.fixed));
 	out.pod(static_cast<std::uint8_t>(b.rigid));
 	out.size(b.fixedPoints.size());
@@ -86,11 +88,14 @@ void writeBlock(StateWriter& out, const Block& b) {
 	out.pod(b.size);
 }
 
+// The block's topology is its own; World::readState interns it.
 Block readBlock(StateReader& in) {
 	Block b;
-	b.shape = std::make_shared<const ConvexPolyhedron>(readShape(in));
+	ConvexPolyhedron shape = readShape(in);
+	b.initialVertices = std::move(shape.vertices);
+	b.shape = std::make_shared<const PolyhedronTopology>(std::move(static_cast<PolyhedronTopology&>(shape)));
 	in.matrixVector(b.vertices, "current vertices");
-	if (b.vertices.size() != b.shape->vertices.size()) in.fail("a block's current and initial vertices differ in number");
+	if (b.vertices.size() != b.initialVertices.size()) in.fail("a block's current and initial vertices differ in number");
 	in.matrix(b.centroid);
 	in.pod(b.volume);
 	in.matrix(b.secondMoment);
@@ -101,7 +106,12 @@ Block readBlock(StateReader& in) {
 	in.matrix(b.strain);
 	Material& m = b.material;
 	for (double* x : {&m.density, &m.young, &m.poisson, &m.frictionAngle, &m.cohesion, &m.tensileStrength}) in.pod(*x);
-	in.matrix(b.elasticity);
+	// The block holds no elasticity matrix (Block::elasticity computes it from
+	// the material); the one saved must be that one, or the restored block
+	// would not continue as the saved one.
+	Matrix6 elasticity;
+	in.matrix(elasticity);
+	if (elasticity != b.elasticity()) in.fail("a block's elasticity matrix does not follow from its young and poisson");
 	b.fixed = in.pod<std::uint8_t>() != 0;
 	b.rigid = in.pod<std::uint8_t>() != 0;
 	b.fixedPoints.resize(in.size(7 * sizeof(double), "fixed points"));
@@ -295,7 +305,10 @@ void World::readState(StateReader& in) {
 
 	in.tag("BLKS");
 	w.blocks_.resize(in.size(64, "blocks"));
-	for (Block& b : w.blocks_) b = readBlock(in);
+	for (Block& b : w.blocks_) {
+		b = readBlock(in);
+		b.shape = w.topologies_.intern(std::move(b.shape));
+	}
 	const int n = w.blockCount();
 	if (w.internalFaces_.size() > w.blocks_.size()) in.fail("more internal-face lists than blocks");
 	for (std::size_t b = 0; b < w.internalFaces_.size(); ++b)
