@@ -173,7 +173,8 @@ def stats():
     volumes), ``shellTests`` (volume comparisons), ``shellUpdates``,
     ``subUnitPairs`` (vertex-face plus edge-edge pairs the candidates offer),
     ``subUnitTests`` (vertex-face plane tests and edge-edge tests the narrow
-    phase made), ``fullSearchPairs`` (MSC pairs searched again with every
+    phase's search covers; a face's tests count in full even when the search
+    stops early on it), ``fullSearchPairs`` (MSC pairs searched again with every
     sub-unit because they penetrate deeper than d0/2), ``contactPairs`` (pairs within d0), ``contacts``
     (vertex-face and edge-edge sub-contacts), ``closedContacts``,
     ``slidingContacts``, ``openCloseIterations`` (solves in the accepted

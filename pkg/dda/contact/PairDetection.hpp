@@ -230,7 +230,9 @@ struct PairContacts {
 // of random, slender and paper scenes).
 // `work` (optional) is increased by what the call did.
 struct NarrowPhaseWork {
-	long subUnitTests = 0;  // vertex-face plane tests plus edge-edge tests
+	// Vertex-face plane tests plus edge-edge tests the search covers: a face
+	// axis counts every corner of the other block, also when it stops early.
+	long subUnitTests = 0;
 	long fullSearches = 0;  // linked pairs searched again with every sub-unit
 };
 std::optional<PairContacts> detectPairContacts(const BlockGeometry& a, const BlockGeometry& b,
