@@ -15,6 +15,7 @@
 #include "dda/contact/PairDetection.hpp"
 #include "dda/geometry/MassProperties.hpp"
 #include "dda/geometry/ConvexPolyhedron.hpp"
+#include "dda/solver/World.hpp"
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
@@ -962,6 +963,68 @@ TEST(ContactDetection, EdgeEntranceOfCrossedLogsApartHasNoDeepSubContacts) {
 	ASSERT_FALSE(result->contacts.empty());
 	for (const SubContact& c : result->contacts)
 		EXPECT_GE(c.gap, -settings.lengthTolerance) << "a sub-contact " << c.gap << " m deep between blocks apart";
+}
+
+// Two pairs of slender blocks of bench/colliders.py's 10,000-block deposit
+// (blocks 1581 and 1817, 3.7 mm apart; 7003 and 7062, 0.28 mm apart), with
+// the settings World gives them (d0 = 1 cm, allowed displacement 4 mm). An
+// edge of one block passes an edge of the other's entrance face about 1 cm
+// away, on the far side of the face's plane: the crossing's stencil, signed by
+// the edges' outward directions, took that distance as a penetration. Each
+// pair had one edge-edge sub-contact about 9 mm "deep" (closed at the first
+// step, a push of 1 cm of penalty spring between blocks that do not touch; 4
+// such in the deposit, 24 in the 50,000-block one), because a face entrance's
+// crossings could lie d0 deeper than the pair's penetration. Blocks that do
+// not overlap have no sub-contact deeper than the length tolerance.
+TEST(ContactDetection, EdgeCrossingsOfBlocksApartAreNeverDeep) {
+	const std::vector<std::vector<Vector3>> blocks = {
+	    {{0.745555184390051, 12.001337305239087, 3.799824323623012},
+	     {0.5401898040352835, 12.01097108487229, 2.6089061969474336},
+	     {0.5393008580974489, 12.098320800050473, 3.8361759541980005},
+	     {0.33393547774268145, 12.107954579683675, 2.6452578275224212},
+	     {0.840264544566901, 12.208249456793183, 3.7851661558503027},
+	     {0.6348991642121337, 12.217883236426385, 2.5942480291747243},
+	     {0.634010218274299, 12.305232951604568, 3.8215177864252903},
+	     {0.42864483791953156, 12.314866731237771, 2.630599659749712}},
+	    {{0.6021424774571142, 12.048944473357789, 3.889031056504369},
+	     {0.18298112208327638, 9.895780747109974, 4.1544733100657245},
+	     {0.8443479073518616, 11.984438502119756, 3.748251807454271},
+	     {0.42518655197802374, 9.83127477587194, 4.013694061015626},
+	     {0.7321126965809328, 12.051088299530925, 4.1116576397430835},
+	     {0.31295134120709506, 9.897924573283108, 4.377099893304439},
+	     {0.9743181264756802, 11.98658232829289, 3.970878390692985},
+	     {0.5551567711018424, 9.833418602045075, 4.236320644254341}},
+	    {{7.140621596014642, 14.227962579673665, 13.430882304955013},
+	     {7.4265188873964565, 14.270157560315036, 14.530458537338859},
+	     {7.2558817913125875, 14.100502160046865, 13.405805018916057},
+	     {7.541779082694401, 14.142697140688236, 14.505381251299903},
+	     {7.255736281755718, 14.33878415377581, 13.396699053336304},
+	     {7.541633573137531, 14.380979134417181, 14.49627528572015},
+	     {7.370996477053662, 14.21132373414901, 13.371621767297349},
+	     {7.656893768435476, 14.253518714790381, 14.471197999681195}},
+	    {{6.69414943716485, 14.507673557341674, 14.89426935952585},
+	     {8.1329573358774, 13.885084572167203, 14.215156826373018},
+	     {6.729235887959081, 14.393103891076107, 15.073639447465567},
+	     {8.16804378667163, 13.770514905901639, 14.394526914312733},
+	     {6.5908127400277525, 14.353929714428041, 14.816281647113273},
+	     {8.029620638740303, 13.731340729253573, 14.137169113960441},
+	     {6.6258991908219835, 14.239360048162476, 14.995651735052988},
+	     {8.064707089534533, 13.616771062988006, 14.316539201900154}}};
+	const std::vector<double> apart = {3.67e-3, 2.8e-4};  // the pairs' distances [m] (separating axes)
+	for (int p = 0; p < 2; ++p) {
+		SCOPED_TRACE("pair " + std::to_string(p));
+		const dda::Block a = dda::makeBlock(blocks[2 * p], dda::Material{}, false);
+		const dda::Block b = dda::makeBlock(blocks[2 * p + 1], dda::Material{}, false);
+		const DetectionSettings settings =
+		    dda::pairDetectionSettings(dda::boundingDiagonal(a), dda::boundingDiagonal(b), 0.01, 0.004);
+		const auto result = dda::detectPairContacts(dda::BlockGeometry{a.shape.get(), &a.vertices, a.centroid},
+		                                            dda::BlockGeometry{b.shape.get(), &b.vertices, b.centroid}, settings);
+		ASSERT_TRUE(result.has_value());
+		EXPECT_NEAR(result->separation, apart[p], 1e-4);
+		ASSERT_FALSE(result->contacts.empty());
+		for (const SubContact& c : result->contacts)
+			EXPECT_GE(c.gap, -settings.lengthTolerance) << "a sub-contact " << c.gap << " m deep between blocks apart";
+	}
 }
 
 // A cube tilted 0.004 rad and turned 0.3 rad over a fixed unit cube, its

@@ -35,10 +35,15 @@ constexpr double kSameNormalCosine = 0.9;
 constexpr double kAreaTieRelative = 1e-9;
 
 // An edge-edge sub-contact of a face entrance may penetrate at most this many
-// times the entrance's penetration, plus max(d0, lengthTolerance)
-// (dimensionless). A crossing whose line distance is much deeper than the
-// pair's penetration is an edge piercing the face steeply near its boundary:
-// its normal lies in the face and would push the block sideways by that depth.
+// times the entrance's penetration, plus lengthTolerance (dimensionless). A
+// crossing whose line distance is much deeper than the pair's penetration is
+// an edge piercing the face steeply near its boundary: its normal lies in the
+// face and would push the block sideways by that depth. With no penetration
+// the limit is the tolerance alone, as for corners: a pair whose entrance
+// axis separates it does not overlap, and a crossing "deep" in it is an edge
+// passing another beyond the face's plane (a slack of d0 here once let such
+// passes 9 mm from each other count as 9 mm deep contacts between blocks
+// 0.3 to 4 mm apart).
 constexpr double kEdgePenetrationFactor = 2;
 
 // An edge-edge sub-contact of a face entrance must push within 60 degrees of
@@ -765,8 +770,9 @@ void faceEntranceContacts(const Prepared& owner, bool ownerIsA, int f, const Pre
 		out.push_back(vertexFaceContact(ownerIsA, owner, q, other, bestFace));
 	}
 
-	// Edges of the other block crossing the face's edges.
-	const double deepest = kEdgePenetrationFactor * std::min(separation, 0.0) - reach;
+	// Edges of the other block crossing the face's edges, no deeper than the
+	// pair's penetration allows (kEdgePenetrationFactor).
+	const double deepest = kEdgePenetrationFactor * std::min(separation, 0.0) - settings.lengthTolerance;
 	std::vector<int>& faceEdges = s.faceEdges;
 	faceEdges.clear();
 	for (int e : owner.edgeList) {
