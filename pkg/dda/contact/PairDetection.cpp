@@ -144,20 +144,7 @@ struct Scratch {
 	std::vector<Vector3> pointsA, pointsB;
 	std::vector<int> identity;  // 0, 1, 2, ...: "every sub-unit"
 	std::vector<char> vertexLinked[2];
-	// sin(angle) of the last angleTolerance (every pair of a run has the same).
-	double sinAngle = std::numeric_limits<double>::quiet_NaN(), sinValue = 0;
 };
-
-// std::sin(angle), computed once per thread while the angle stays the same
-// double (compared with its sign, so -0 is not taken for +0; NaN is never
-// the same and is computed every time).
-double cachedSin(Scratch& s, double angle) {
-	if (!(angle == s.sinAngle && std::signbit(angle) == std::signbit(s.sinAngle))) {
-		s.sinValue = std::sin(angle);
-		s.sinAngle = angle;
-	}
-	return s.sinValue;
-}
 
 Scratch& scratch() {
 	thread_local Scratch s;
@@ -1014,7 +1001,7 @@ bool detectPairContacts(const BlockGeometry& blockA, const BlockGeometry& blockB
 	ensureIdentity(s, a, b);
 	prepareSubUnits(a, linked, 0, s, tests);
 	prepareSubUnits(b, linked, 1, s, tests);
-	const double sinTolerance = cachedSin(s, settings.angleTolerance);
+	const double sinTolerance = std::sin(settings.angleTolerance);
 
 	// 1. Face axes, stopping at the first one farther than d0. Any axis
 	// farther than d0 rejects the pair, so the likeliest separating face of
