@@ -275,6 +275,17 @@ py::dict lastStep(const SceneLink& s) {
 	memory["narrowPhase"] = use.narrowPhase;
 	memory["solver"] = use.solver;
 	d["memory"] = memory;
+	const EnergyAccount account = s.world.energy();
+	py::dict energy;
+	energy["kinetic"] = account.kinetic;
+	energy["gravity"] = account.gravity;
+	energy["strain"] = account.strain;
+	energy["contact"] = account.contact;
+	energy["friction"] = account.friction;
+	energy["damping"] = account.damping;
+	energy["loads"] = account.loads;
+	energy["contactChanges"] = account.contactChanges;
+	d["energy"] = energy;
 	d["contactPairs"] = st.contactPairs;
 	d["contacts"] = st.contacts;
 	d["closedContacts"] = st.closedContacts;
@@ -283,7 +294,9 @@ py::dict lastStep(const SceneLink& s) {
 	d["openCloseIterationsTotal"] = st.openCloseIterationsTotal;
 	d["stateChanges"] = st.stateChanges;
 	d["normalForceUpdates"] = st.normalForceUpdates;
-	d["openCloseHeld"] = st.openCloseHeld;
+	d["lineSearches"] = st.lineSearches;
+	d["limitPasses"] = st.limitPasses;
+	d["limitsUnsettled"] = st.limitsUnsettled;
 	d["openCloseCuts"] = st.openCloseCuts;
 	d["openCloseFailures"] = st.openCloseFailures;
 	d["maxPenetration"] = st.maxPenetration;

@@ -12,7 +12,7 @@
 //      a sphere, near-coincident points; scaled by 10^-15 .. 10^15 and moved
 //      up to 10^14 from the origin;
 //   1  detectPairContacts and the contact equations (prepareContact,
-//      contactTerms for each state, updateContactState, finishContact) on two
+//      contactTerms for each state, evaluateContact, finishContact) on two
 //      valid blocks placed: at random, corner on corner, edge on edge
 //      (crossing or parallel), face on face (coplanar, turned, offset), one
 //      inside the other, identical, or at exactly d0 along a face normal;
@@ -430,6 +430,8 @@ void exerciseEquations(Recipe& in, const PairContacts& pair, const Block& a, con
 			c.trial.anchorJ = sub.pointJ;
 			c.trial.slidingDirection = in.coin() ? Vector3::Zero() : in.direction();
 			c.trial.normalForce = in.coin() ? 0.0 : c.normalStiffness * scale * in.unit();
+			c.stretch = in.coin() ? Vector3::Zero() : Vector3(scale * in.unit() * in.direction());
+			c.slipLimit = in.coin() ? 0.0 : c.normalStiffness * scale * in.unit();
 			Matrix24 stiffness;
 			Vector24 force;
 			if (contactTerms(c, bi, bj, stiffness, force)) {
@@ -437,7 +439,7 @@ void exerciseEquations(Recipe& in, const PairContacts& pair, const Block& a, con
 				requireFinite(force, "contact force");
 			}
 			requireFinite(contactGap(c, Di, Dj), "contact gap");
-			updateContactState(c, bi, bj, Di, Dj, scale * 1e-9);
+			evaluateContact(c, bi, bj, Di, Dj, in.coin());
 			checkContact(c);
 			finishContact(c, bi, bj, Di, Dj);
 			checkContact(c);

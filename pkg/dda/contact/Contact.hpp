@@ -44,20 +44,24 @@ struct ContactKeyHash {
 	}
 };
 
-// What a sub-contact carries into the next step.
+// What a sub-contact carries into the next step. Locked or sliding is the
+// regime of its tangential spring (ContactEquations.hpp): within Coulomb's
+// limit, or at it.
 struct ContactHistory {
 	ContactState state = ContactState::Open;
-	// Locked: the shear spring joins these two material points, one of block
-	// i and one of block j [m], moved with their blocks every step.
+	// Closed: the tangential spring joins these two material points, one of
+	// block i and one of block j [m], moved with their blocks every step; their
+	// separation in the tangent plane is the spring's stretch.
 	Vector3 anchorI = Vector3::Zero(), anchorJ = Vector3::Zero();
-	// Sliding: unit direction of block i's motion relative to block j, along
-	// which friction resists.
+	// Sliding: unit direction of the spring's stretch (block i's slip relative
+	// to block j), along which friction resists.
 	Vector3 slidingDirection = Vector3::Zero();
 	double normalForce = 0;  // [N], compressive > 0 (tension < 0 only while bonded); feeds friction
 	// A bonded joint (closed when the scene started, both blocks with bond
 	// strength) until tension or shear breaks it; a broken bond never heals.
 	bool bonded = false;
 	Vector3 shearForce = Vector3::Zero();  // force on block i in the tangent plane [N]
+	double energy = 0;  // energy of its springs at the end of the step [J] (World::accountStep)
 };
 
 struct Contact {
@@ -75,8 +79,16 @@ struct Contact {
 	double cohesionForce = 0;    // bond's shear strength beyond friction [N]
 	double tensileForce = 0;     // bond's tensile strength [N]
 	bool isNew = true;           // no history was found
-	int frictionSwitches = 0;    // sliding <-> locked switches in this step's open-close iteration
-	int openCloseSwitches = 0;   // open <-> closed changes in this step's open-close iteration
+	// Within a step (ContactEquations.hpp): the tangential stretch s [m] at
+	// the last trial solution and whether it is past the limit (slipping);
+	// the limit L [N] of the tangential spring, fixed while the step's energy
+	// is minimised and updated from the normal force between such passes,
+	// and its last change [N]; open <-> closed changes of the iteration.
+	Vector3 stretch = Vector3::Zero();
+	bool slipping = false;
+	double slipLimit = 0;
+	double limitChange = 0;
+	int openCloseChanges = 0;
 	// Block i's contact point at the end of the step [m] (for reports).
 	Vector3 point = Vector3::Zero();
 };

@@ -1,42 +1,55 @@
-// Contact mechanics of one sub-contact: its terms in the equations of the two
-// blocks and the open-close rule that updates its state after a solve.
+// Contact mechanics of one sub-contact: its energy, the Newton model of its
+// force that the step's equations take, and its state at a trial solution.
 //
 // Unknowns: D = (D_i, D_j), 24 of them (D of a fixed block is zero). A point x
 // of block b moves by T_b(x) D_b (dda::displacementMatrix about b's centroid).
 //
-// Normal spring (closed contacts). With the linearised gap
-//   d_n(D) = d0 + e_i . D_i + e_j . D_j       (Linearization.hpp)
-// the energy kn/2 d_n^2 adds  K += kn e e^T,  F -= kn d0 e  (e = (e_i, e_j)).
-// Both normal and shear springs push only while the contact is closed; an
-// open contact adds nothing (no tension).
+// The step minimises one convex function of D (World::step): the blocks'
+// inertia, elasticity and loads plus, for every sub-contact within d0, the
+// energy of its springs:
 //
-// Shear spring (locked contacts). The contact's anchors a_i (a material point of
-// block i) and a_j (of block j) coincided when the contact locked; their
-// relative displacement is
-//   delta(D) = (a_i - a_j) + G D,   G = [T_i(a_i), -T_j(a_j)]   (3 x 24)
-// and the spring acts in the tangent plane, P = I - n n^T (n the start-of-step
-// normal): energy ks/2 |P delta|^2, so  K += ks G^T P G,  F -= ks G^T P (a_i - a_j).
+// Normal penalty spring, compression only. With the linearised gap
+//   d(D) = d0 + e_i . D_i + e_j . D_j          (Linearization.hpp)
+// its energy is kn/2 min(0, d)^2: no force while apart, kn |d| when
+// penetrating, never tension. A bonded contact (below) holds tension: kn/2 d^2.
 //
-// Friction (sliding contacts). A force of magnitude tan(phi) N opposes l, the
-// direction of block i's motion relative to block j (N the normal force of
-// the previous iteration); it is a load: F += H^T (-tan(phi) N l), with
-// H = [T_i(p_i), -T_j(p_j)] at the contact points.
+// Tangential spring with Coulomb's limit (elastoplastic, as Cundall and
+// Strack's DEM contact). The anchors a_i (a material point of block i) and
+// a_j (of block j) carry the spring's stretch from step to step; their
+// separation in the tangent plane P = I - n n^T (n the start-of-step
+// normal) is
+//   s(D) = P ((a_i - a_j) + G D),   G = [T_i(a_i), -T_j(a_j)]   (3 x 24).
+// The spring pushes back with ks s up to the limit L = tan(phi) N (+ c A
+// while bonded), N the normal force; beyond it the contact slips and the
+// force is L s/|s|. With N held, this is the gradient of the convex
+// function psi(s) = ks/2 |s|^2 for ks |s| <= L, L |s| - L^2/(2 ks) beyond.
+// After a slipping step the anchors are moved so that the stretch is L/ks
+// along the slip: the spring keeps the friction force it carried, so a
+// contact that stops slipping holds on with that force instead of starting
+// again from an unloaded spring.
 //
-// Open-close rule after a solve (Shi), with u = H D the relative motion:
-//   closed and d_n > tolerance       -> open
-//   open and d_n < 0                 -> closed: locked (sliding if frictionless)
-//   locked and ks |P delta| > tan(phi) N   -> sliding along P delta
-//   sliding and (P u) . l <= 0       -> locked (the motion reversed or stopped)
-// A closed contact with zero normal force (gap within the opening band) keeps
-// its locked or sliding state. A frictionless contact that is closed is always
-// sliding, with no friction terms assembled at all.
+// State at a trial solution D (evaluateContact): open when d > 0 (bonded:
+// when kn d exceeds the tensile strength T A, which breaks the bond);
+// otherwise closed, with N = -kn d, and locked (stick: ks |s| <= L) or
+// sliding (slip). A closed frictionless contact without a bond is sliding
+// with L = 0.
+//
+// Newton model at the state (contactTerms), the exact second-order
+// expansion of the energy about the trial solution:
+//   closed: K += kn e e^T, F -= kn d0 e   (e = (e_i, e_j));
+//   locked: K += ks G^T P G, F -= ks G^T P (a_i - a_j);
+//   sliding with L > 0, at the trial stretch s_k (unit l = s_k/|s_k|):
+//     the force L l + C (s - s_k), C = (L/|s_k|)(P - l l^T) (C s_k = 0):
+//     K += G^T C G, F -= G^T (L l + C (a_i - a_j)).
+// N (hence L) is that of the trial solution before: the step iterates
+// until states and forces settle (World::step).
 //
 // Bonded joints (cohesion c and tensile strength T of the materials, the
 // smaller of the two blocks; A the contact's share of its pair's contact
 // area): contacts closed when the scene starts are bonded. A bonded contact
-// stays closed in tension while kn d_n <= T A, and stays locked while
-// ks |P delta| <= tan(phi) max(N, 0) + c A; exceeding either breaks the bond
-// for good (then the rules above apply: no tension, pure Coulomb friction).
+// holds tension while kn d <= T A, and stays locked while ks |s| <= tan(phi)
+// max(N, 0) + c A; exceeding either breaks the bond for good (then the rules
+// above apply: no tension, pure Coulomb friction).
 #pragma once
 
 #include "IntegratorSettings.hpp"
@@ -54,46 +67,98 @@ using Matrix24 = Eigen::Matrix<double, 24, 24>;
 // from the two blocks (block i owns the vertex or first edge).
 void prepareContact(Contact& contact, const Block& blockI, const Block& blockJ, const IntegratorSettings& settings);
 
-// The contact's 24x24 stiffness and 24 force terms for its trial state;
-// false (nothing to add) when the trial state is open.
+// The contact's 24x24 stiffness and 24 force terms of its Newton model at
+// its trial state (see above); false (nothing to add) when it is open.
 bool contactTerms(const Contact& contact, const Block& blockI, const Block& blockJ, Matrix24& stiffness,
                   Vector24& force);
 
 // Which tangential term contactTerms adds for the contact's trial state: the
-// shear spring of a locked contact, the friction load of a sliding one with
-// friction and a compressive normal force, or none (open, or frictionless
-// sliding). World counts these (StepStatistics::frictionTerms).
+// stick spring of a locked contact, the slip force of a sliding one with a
+// positive limit, or none (open, or frictionless). World counts these
+// (StepStatistics::frictionTerms).
 enum class TangentialTerm { None, ShearSpring, FrictionLoad };
 TangentialTerm tangentialTerm(const Contact& contact);
 
-// The trial state the solution implies; true when the state changed.
-// `openTolerance` [m] is the gap above which a closed contact opens.
-bool updateContactState(Contact& contact, const Block& blockI, const Block& blockJ, const Vector12& Di,
-                        const Vector12& Dj, double openTolerance);
+// Sets the contact's trial state from the trial solution (Di, Dj): open or
+// closed and its normal force, its stretch and whether it slips past its
+// (fixed) limit; breaks a bond in tension or shear beyond its strength. True
+// when open/closed, stick/slip or the bond changed.
+bool evaluateContact(Contact& contact, const Block& blockI, const Block& blockJ, const Vector12& Di,
+                     const Vector12& Dj);
+
+// Moves the contact's friction limit to tan(phi) max(N, 0) (+ c A while
+// bonded) for its normal force now, halfway where the limit swings back (a
+// change opposite to its last: a limit that follows N and an N that follows
+// the friction can swap between two values); returns |target - limit|
+// before the move [N]. Without `apply` only returns it.
+double updateFrictionLimit(Contact& contact, bool apply);
+
+// Whether the contact is closed in its trial state.
+inline bool isClosed(const Contact& contact) { return contact.trial.state != ContactState::Open; }
+
+// The tangential force on block i [N] at the trial solution (Di, Dj) by the
+// Newton model the last contactTerms used (locked: -ks s; sliding: -(L l +
+// C (s - s_k))), and by the exact law at the state now evaluated; World
+// compares the two to know when the iteration has settled.
+Vector3 tangentialForce(const Contact& contact, const Block& blockI, const Block& blockJ, const Vector12& Di,
+                        const Vector12& Dj);
 
 // Linearised gap for the unknowns [m].
 double contactGap(const Contact& contact, const Vector12& Di, const Vector12& Dj);
 
+// The derivative of the contact's energy (normal and tangential, at the
+// limit of its trial state) along D = D_k + t Delta at t, for the step's line
+// search: `line` holds the gap and stretch at t = 0 and their rates.
+struct ContactLine {
+	double gap = 0, gapRate = 0;   // d(D_k) [m], e . Delta [m]
+	Vector3 stretch = Vector3::Zero(), stretchRate = Vector3::Zero();  // s(D_k), P G Delta [m]
+	double normalStiffness = 0, shearStiffness = 0;  // [N/m]
+	double limit = 0;      // L [N]; 0: no tangential force
+	bool bonded = false;   // holds tension
+	bool tangential = false;
+	double derivative(double t) const;
+};
+ContactLine contactLine(const Contact& contact, const Block& blockI, const Block& blockJ, const Vector12& Di,
+                        const Vector12& Dj, const Vector12& deltaI, const Vector12& deltaJ);
+
 // Closes the step for the contact: forces from the accepted solution into the
-// trial state; call before the blocks move (then moveAnchors).
+// trial state, and a slipping contact's anchor i moved so that its stretch is
+// L/ks along the slip; call before the blocks move.
 void finishContact(Contact& contact, const Block& blockI, const Block& blockJ, const Vector12& Di, const Vector12& Dj);
 
-// A trial state for the start of a step's iteration: the history, or for a
-// new contact closed (locked, or sliding if nothing can lock it) when it
-// already touches or penetrates, open otherwise. With `formBonds` (the scene's
-// first step) a new closed contact between blocks with bond strength is a
-// bonded joint.
+// A trial state for the start of a step's iteration: the history; the
+// anchors of a contact that was open (or is new) are its two points now. With
+// `formBonds` (the scene's first step) a new contact that touches or
+// penetrates between blocks with bond strength is a bonded joint.
+// evaluateContact at D = 0 then sets its state.
 void startTrial(Contact& contact, bool formBonds);
 
-// A new contact that startTrial locked, between blocks whose start rates Vi,
-// Vj [m/s, rad/s, 1/s] move its points apart tangentially, starts sliding
-// along that motion instead when its shear spring would exceed the friction
-// capacity within the step: ks |v_t| dt > tan(phi) N (always, for a contact
-// that only touches: N = 0). A locked spring on a block arriving with
-// tangential speed holds the whole step's slip (a 1 m cube sliding at 2 m/s
-// lost 40% of its speed in its first step, tipped by the spring, and hopped).
-// Bonded contacts stay locked.
-void startSlidingIfMoving(Contact& contact, const Block& blockI, const Block& blockJ, const Vector12& Vi,
-                          const Vector12& Vj, double dt);
+// A contact's share of the energy account of an accepted step (World's
+// EnergyAccount), in its accepted (trial) state and the step's solution
+// [J]. Shi's scheme makes the change of the kinetic energy over a step
+// exactly the work of the end-of-step forces over the step's displacement
+// (F(D) . D, see World::accountStep). For a force with a convex potential U,
+// F(D) . D = -(U(D) - U(0)) - B, B = U(0) - U(D) - grad U(D) . (0 - D) >= 0,
+// the Bregman divergence: the energy the scheme's numerical damping takes.
+//   - normal spring of an unbonded closed contact: U = kn/2 min(0, d)^2, d
+//     the linearised gap (compression only; an unbonded contact has no
+//     tension), so start = U(d0), end = U(d1), damping = B;
+//   - bonded contact: U = kn/2 d^2 (it holds tension);
+//   - tangential spring: U = ks/2 |s|^2 of the stretch s while locked. A
+//     sliding contact ends with the stretch r l (r = L/ks), stores ks/2 r^2,
+//     and its slip |s1| - r dissipates L (|s1| - r) by friction; the
+//     rest of the force's work, ks/2 |r l - s0|^2, is the scheme's damping
+//     (the three add up to L l . (s1 - s0), the force's work).
+// These are exact only when the forces the solve used are these gradients:
+// an unconverged step, or tension in an unbonded contact, breaks the
+// identity, and the account shows it.
+struct ContactStepEnergy {
+	double start = 0;     // spring energy at D = 0 in the accepted state [J]
+	double end = 0;       // spring energy at the step's solution [J]
+	double damping = 0;   // the springs' Bregman divergence (>= 0) [J]
+	double friction = 0;  // dissipated by slip [J]
+};
+ContactStepEnergy contactStepEnergy(const Contact& contact, const Block& blockI, const Block& blockJ,
+                                    const Vector12& Di, const Vector12& Dj);
 
 }  // namespace dda

@@ -72,6 +72,31 @@ struct IntegratorSettings {
 	int threads = 0;
 };
 
+// The energy account of a scene [J] (World::energy; Python stats()['energy']).
+// kinetic, gravity, strain and contact are the state's energies now; friction,
+// damping and loads add up over the steps. Each term has its own formula (see
+// World::accountStep and contactStepEnergy); none is the residual of the
+// others. kinetic + gravity + strain + contact + friction + damping - loads
+// - contactChanges is conserved by Shi's scheme to round-off and the
+// second-order terms of the exact block update (rotation of J and of the
+// stress, volume change), so a drift of it is a bug.
+struct EnergyAccount {
+	double kinetic = 0;   // 1/2 v^T M v, consistent mass: translation, rotation and strain rates
+	double gravity = 0;   // -m g . c, potential of the last step's gravity
+	double strain = 0;    // V/2 sigma^T E^-1 sigma (the blocks' elastic energy, initial stress included)
+	double contact = 0;   // energy in the closed contacts' springs at the end of the last step
+	double friction = 0;  // dissipated by sliding (work of friction loads against the relative motion)
+	double damping = 0;   // dissipated by the time scheme (and by velocityRatio < 1)
+	double loads = 0;     // work done on the blocks by point loads and fixed-point springs
+	// Energy the contacts' springs gained between the end of one step and the
+	// start of the next (D = 0 of the next step in its accepted states): new
+	// contacts found penetrating, gaps linearised again from the moved
+	// geometry, contacts that open or slide (their springs' energy lost),
+	// contacts that vanish. No formula of the scheme covers it; it is what
+	// contact detection and the contact states add or remove.
+	double contactChanges = 0;
+};
+
 // What the last step did, readable from Python as yade_dda.stats().
 struct StepStatistics {
 	double dt = 0;                   // time step taken [s]
@@ -102,8 +127,10 @@ struct StepStatistics {
 	int openCloseIterations = 0;     // solves in the accepted attempt
 	int openCloseIterationsTotal = 0;  // solves in all attempts of the step
 	int stateChanges = 0;            // contact state changes in the accepted attempt
-	int normalForceUpdates = 0;      // solves made only because sliding contacts' normal forces had not settled (all attempts)
-	int openCloseHeld = 0;           // openings undone: a cycling contact held closed within its gap band (all attempts)
+	int normalForceUpdates = 0;      // solves made only because tangential forces had not settled (all attempts)
+	int lineSearches = 0;            // solves whose step was shortened by the line search (all attempts)
+	int limitPasses = 0;             // passes made after the first because friction limits changed (all attempts)
+	int limitsUnsettled = 0;         // attempts accepted with limits still changing after kLimitPasses passes
 	int openCloseCuts = 0;           // dt cuts because the iteration did not converge
 	long openCloseFailures = 0;      // steps accepted unconverged after maxStepCuts (cumulative)
 	double maxPenetration = 0;       // deepest closed contact at the end of the step [m]

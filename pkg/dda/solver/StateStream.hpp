@@ -31,7 +31,7 @@ public:
 
 // Format version of the saved state. Bump it whenever what is written, or the
 // meaning of a written value, changes; older states are then refused by name.
-inline constexpr std::uint32_t kStateVersion = 3;  // 2: a block's rigid flag; 3: MSC frames, no shell boxes
+inline constexpr std::uint32_t kStateVersion = 4;  // 2: a block's rigid flag; 3: MSC frames, no shell boxes; 4: the energy account
 
 class StateWriter {
 public:

@@ -9,6 +9,8 @@
 #include <chrono>
 #include <cmath>
 #include <ctime>
+#include <cstdio>
+#include <cstdlib>
 #include <sstream>
 
 namespace dda {
@@ -41,18 +43,20 @@ constexpr double kEntranceHysteresis = 0.1;
 constexpr double kCornerMergeFraction = 1e-3;
 // Largest angle [rad] below which two edges count as parallel (about 3 degrees).
 constexpr double kMaxParallelAngleTolerance = 0.05;
-// Sliding/locked switches of one contact that keep an open-close iteration going (see step()).
-constexpr int kFrictionSwitchesCounted = 2;
-// Open/closed changes of one contact that keep an open-close iteration going,
-// and the gap band (fraction of the allowed step displacement) within which a
-// contact that keeps cycling is held closed (see step()).
-constexpr int kOpenCloseSwitchesCounted = 2;
-constexpr double kHoldClosedFraction = 1e-3;
-// Sliding contacts' normal forces have settled when a solve changes each by at
-// most this fraction of the largest normal force (the friction load lags N by
-// one solve); solves of a step that may be spent on settling them.
+// The iteration has settled when, besides no state changing, every contact's
+// tangential force agrees with the model the last solve used to within this
+// fraction of the largest normal force (a sliding contact's limit follows the
+// normal force of the iterate before, and its direction is linearised).
 constexpr double kNormalForceTolerance = 1e-4;
-constexpr int kNormalForceSolves = 6;
+// A step's friction limits are consistent with its normal forces when a pass
+// changes none by more than this fraction of the largest; a step makes at
+// most kLimitPasses passes (see step()). Any limit >= 0 resists slip, so an
+// unsettled limit is an error in the friction's size, not in the energy.
+constexpr double kLimitTolerance = 1e-3;
+constexpr int kLimitPasses = 12;
+// Solves of a step's iteration that take Newton's full step before the line
+// search is used regardless (see step()).
+constexpr int kFullNewtonSolves = 4;
 double secondsSince(Clock::time_point start) {
 	return std::chrono::duration<double>(Clock::now() - start).count();
 }
@@ -323,7 +327,7 @@ void World::setCollider(std::unique_ptr<Collider> collider) {
 const Vector12& World::solutionOf(int block) const {
 	static const Vector12 zero = Vector12::Zero();
 	const int k = movingIndex_[block];
-	return k < 0 ? zero : solutions_[k];
+	return k < 0 ? zero : iterate_[k];
 }
 
 Vector12 World::startVelocityOf(int block, const IntegratorSettings& settings) const {
@@ -492,7 +496,8 @@ void World::buildSystemStructure(int movingBlocks, StepStatistics& stats) {
 	hasSprings_.assign(movingBlocks, 0);
 	for (int k = 0; k < movingBlocks; ++k) hasSprings_[k] = !blocks_[moving_[k]].fixedPoints.empty();
 	for (const Contact& contact : store_.contacts()) {
-		if (contact.trial.state == ContactState::Open) continue;  // no terms: couples nothing
+		// No terms (open, and no tangential spring): couples nothing.
+		if (contact.trial.state == ContactState::Open && tangentialTerm(contact) == TangentialTerm::None) continue;
 		const int mi = movingIndex_[contact.key.blockI], mj = movingIndex_[contact.key.blockJ];
 		if (mi >= 0) hasSprings_[mi] = 1;
 		if (mj >= 0) hasSprings_[mj] = 1;
@@ -546,11 +551,12 @@ void World::solveAloneBlocks(const IntegratorSettings& settings, double dt) {
 void World::assembleContacts(StepStatistics& stats) {
 	Matrix24 stiffness;
 	Vector24 force;
-	for (const Contact& contact : store_.contacts()) {
+	for (Contact& contact : store_.contacts()) {
 		const int bi = contact.key.blockI, bj = contact.key.blockJ;
 		if (!contactTerms(contact, blocks_[bi], blocks_[bj], stiffness, force)) continue;
 		++stats.normalTerms;
-		stats.frictionTerms += tangentialTerm(contact) != TangentialTerm::None;
+		const TangentialTerm tangential = tangentialTerm(contact);
+		stats.frictionTerms += tangential != TangentialTerm::None;
 		const int mi = movingIndex_[bi], mj = movingIndex_[bj];
 		if (mi >= 0) {
 			coupled_.diagonal(mi) += stiffness.topLeftCorner<12, 12>();
@@ -566,6 +572,263 @@ void World::assembleContacts(StepStatistics& stats) {
 			offDiagonal += transposed ? stiffness.bottomLeftCorner<12, 12>() : stiffness.topRightCorner<12, 12>();
 		}
 	}
+}
+
+void World::groupContacts() {
+	const int n = static_cast<int>(moving_.size());
+	std::vector<int>& root = groupRoot_;
+	root.resize(n);
+	for (int k = 0; k < n; ++k) root[k] = k;
+	auto find = [&](int k) {
+		while (root[k] != k) k = root[k] = root[root[k]];
+		return k;
+	};
+	const std::vector<Contact>& contacts = store_.contacts();
+	for (const Contact& contact : contacts) {
+		const int mi = movingIndex_[contact.key.blockI], mj = movingIndex_[contact.key.blockJ];
+		if (mi < 0 || mj < 0) continue;
+		const int a = find(mi), b = find(mj);
+		if (a != b) root[std::max(a, b)] = std::min(a, b);
+	}
+	for (int k = 0; k < n; ++k) root[k] = find(k);
+	contactGroup_.resize(contacts.size());
+	for (std::size_t c = 0; c < contacts.size(); ++c) {
+		const int mi = movingIndex_[contacts[c].key.blockI];
+		contactGroup_[c] = root[mi >= 0 ? mi : movingIndex_[contacts[c].key.blockJ]];
+	}
+}
+
+void World::GroupIteration::reset(int groups) {
+	done.assign(groups, 0);
+	hasContacts.assign(groups, 0);
+	swungBack.assign(groups, 0);
+	passes.assign(groups, 0);
+	passSolves.assign(groups, 0);
+	changes.assign(groups, 0);
+	newPass.assign(groups, 0);
+	forceChange.assign(groups, 0.0);
+	largestNormalForce.assign(groups, 0.0);
+	limitChange.assign(groups, 0.0);
+	largestLimit.assign(groups, 0.0);
+}
+
+void World::GroupIteration::startIteration() {
+	for (std::size_t g = 0; g < done.size(); ++g) {
+		if (done[g]) continue;
+		++passSolves[g];
+		changes[g] = 0;
+		newPass[g] = 0;
+		forceChange[g] = largestNormalForce[g] = limitChange[g] = largestLimit[g] = 0;
+	}
+}
+
+bool World::GroupIteration::passConverged(int g, double tolerance) const {
+	return changes[g] == 0 && forceChange[g] <= tolerance * largestNormalForce[g];
+}
+
+double World::lineSearch(const IntegratorSettings& settings, double dt) {
+	const int n = static_cast<int>(moving_.size());
+	deltas_.resize(n);
+	for (int k = 0; k < n; ++k) deltas_[k] = solutions_[k] - iterate_[k];
+	auto deltaOf = [&](int block) -> const Vector12& {
+		static const Vector12 zero = Vector12::Zero();
+		const int k = movingIndex_[block];
+		return k < 0 ? zero : deltas_[k];
+	};
+	const std::vector<int>& root = groupRoot_;
+	std::vector<Contact>& contacts = store_.contacts();
+	// Per group (by its root): whether its true energy must be searched,
+	// its blocks' slope and curvature along the step, its contacts' lines.
+	// The Newton step is the exact minimiser of the model along the line
+	// unless some contact crosses a kink of its energy on the way (a gap
+	// changing sign against its state, a stuck stretch passing its limit,
+	// when `searchKinks`) or slips.
+	groupKink_.assign(n, 0);
+	groupSlope_.assign(n, 0.0);
+	groupCurvature_.assign(n, 0.0);
+	lines_.clear();
+	lineGroup_.clear();
+	for (std::size_t c = 0; c < contacts.size(); ++c) {
+		const Contact& contact = contacts[c];
+		const int bi = contact.key.blockI, bj = contact.key.blockJ;
+		const int group = contactGroup_[c];
+		// A slipping contact's force is not quadratic, so a group with one is
+		// always searched. Opening and closing are searched once a contact of
+		// the group has swung back (opened and closed again, or the reverse)
+		// or its pass runs long: a searched step stops at the energy's minimum
+		// along the way, often where the first of many impacting corners
+		// touches, so searching those from the start cost a stiff pile one
+		// solve per closing contact.
+		const bool searchKinks = group_.swungBack[group] || group_.passSolves[group] >= kFullNewtonSolves;
+		const ContactLine line = contactLine(contact, blocks_[bi], blocks_[bj], solutionOf(bi), solutionOf(bj),
+		                                     deltaOf(bi), deltaOf(bj));
+		lines_.push_back(line);
+		lineGroup_.push_back(group);
+		bool kink = false;
+		if (contact.normal.valid && searchKinks) {
+			const double g0 = line.gap, g1 = line.gap + line.gapRate;
+			kink = isClosed(contact) ? (!line.bonded && std::max(g0, g1) > 0) : std::min(g0, g1) < 0;
+		}
+		if (searchKinks && !contact.slipping && line.tangential)
+			kink = kink || (line.stretch + line.stretchRate).norm() > line.limit / line.shearStiffness;
+		// A slipping contact's force is not quadratic: its model is exact
+		// only at the iterate, and Newton's steps alone can swing about the
+		// minimum (seen: the same tangential forces every other solve).
+		kink = kink || (contact.slipping && line.tangential);
+		if (kink) groupKink_[group] = 1;
+	}
+	// d Phi / dt along D_k + t Delta: the blocks' quadratic energy
+	// 1/2 D^T K D - f^T D, plus each contact's (ContactLine). Phi is convex,
+	// so the derivative rises with t; it is negative at 0 (the Newton step
+	// descends), and the minimiser is where it vanishes.
+	BlockSystem own;
+	for (int k = 0; k < n; ++k) {
+		if (!groupKink_[root[k]] || deltas_[k].isZero()) continue;
+		const BlockSystem* system = &own;
+		if (ownSystemOf_[k] >= 0)
+			system = &ownSystems_[ownSystemOf_[k]];
+		else
+			assembleBlock(blocks_[moving_[k]], settings, dt, own);
+		groupSlope_[root[k]] += deltas_[k].dot(system->stiffness * iterate_[k] - system->force);
+		groupCurvature_[root[k]] += deltas_[k].dot(system->stiffness * deltas_[k]);
+	}
+	// The lines of each searched group, together (a counting sort by group).
+	groupStep_.assign(n, 1.0);
+	lineOrder_.clear();
+	groupLines_.assign(n + 1, 0);
+	for (std::size_t c = 0; c < lines_.size(); ++c)
+		if (groupKink_[lineGroup_[c]]) ++groupLines_[lineGroup_[c] + 1];
+	for (int g = 0; g < n; ++g) groupLines_[g + 1] += groupLines_[g];
+	lineOrder_.resize(groupLines_[n]);
+	{
+		std::vector<int> next(groupLines_.begin(), groupLines_.end() - 1);
+		for (std::size_t c = 0; c < lines_.size(); ++c)
+			if (groupKink_[lineGroup_[c]]) lineOrder_[next[lineGroup_[c]]++] = static_cast<int>(c);
+	}
+	double smallest = 1;
+	for (int g = 0; g < n; ++g) {
+		if (!groupKink_[g] || group_.done[g]) continue;
+		auto derivative = [&](double at) {
+			double value = groupSlope_[g] + at * groupCurvature_[g];
+			for (int c = groupLines_[g]; c < groupLines_[g + 1]; ++c) value += lines_[lineOrder_[c]].derivative(at);
+			return value;
+		};
+		if (!(derivative(1) > 0)) continue;
+		double low = 0, high = 1;
+		for (int k = 0; k < 60 && high - low > 1e-12; ++k) {
+			const double mid = 0.5 * (low + high);
+			(derivative(mid) > 0 ? high : low) = mid;
+		}
+		// A step this close to the full one lowers the energy by no
+		// measurable amount more: take the Newton point.
+		const double t = 0.5 * (low + high);
+		if (t <= 1 - 1e-9) groupStep_[g] = t;
+		smallest = std::min(smallest, groupStep_[g]);
+	}
+	for (int k = 0; k < n; ++k) {
+		if (group_.done[root[k]]) continue;  // converged: kept
+		const double t = groupStep_[root[k]];
+		if (t == 1)
+			iterate_[k] = solutions_[k];
+		else
+			iterate_[k] += t * deltas_[k];
+	}
+	return smallest;
+}
+
+EnergyAccount World::energy() const {
+	EnergyAccount account = energy_;
+	account.kinetic = account.gravity = account.strain = 0;
+	for (const Block& block : blocks_) {
+		if (block.fixed) continue;
+		account.gravity -= block.mass * gravity_.dot(block.centroid);
+		if (block.rigid) {
+			const Vector6 v = block.velocity.head<6>();
+			account.kinetic += 0.5 * v.dot(rigidMassMatrix(block.density(), block.volume, block.secondMoment) * v);
+			continue;
+		}
+		account.kinetic +=
+		    0.5 * block.velocity.dot(massMatrix(block.density(), block.volume, block.secondMoment) * block.velocity);
+		if (!block.stress.isZero())
+			account.strain += 0.5 * block.volume * block.stress.dot(block.elasticity().ldlt().solve(block.stress));
+	}
+	return account;
+}
+
+void World::accountStep(const IntegratorSettings& settings, double dt) {
+	(void)dt;
+	// Blocks. Shi's scheme (v1 = 2D/dt - v0, (2/dt^2) M D = (2/dt) M v0 + F(D))
+	// gives 1/2 v1^T M v1 - 1/2 v0^T M v0 = F(D) . D exactly: the kinetic
+	// energy changes by the work of the end-of-step forces over D. Gravity's
+	// work is minus the change of its potential exactly (the centroid moves
+	// by D's translation). The elastic force -V (sigma0 + E eps) has the
+	// potential V (sigma0 . eps + eps^T E eps / 2) (the change of the strain
+	// energy) and the Bregman divergence V/2 eps^T E eps: the damping. Point
+	// loads and fixed-point springs (end-of-step force) do the work F . u.
+	const int n = static_cast<int>(moving_.size());
+	for (int k = 0; k < n; ++k) {
+		const Block& block = blocks_[moving_[k]];
+		const Vector12& D = solutions_[k];
+		if (settings.velocityRatio < 1) {
+			// Velocities scaled by velocityRatio at the step's start: the
+			// kinetic energy removed is damping.
+			const double ratio = settings.velocityRatio;
+			const double kinetic =
+			    block.rigid ? 0.5 * block.velocity.head<6>().dot(rigidMassMatrix(block.density(), block.volume,
+			                                                                       block.secondMoment) *
+			                                                      block.velocity.head<6>())
+			                : 0.5 * block.velocity.dot(massMatrix(block.density(), block.volume, block.secondMoment) *
+			                                           block.velocity);
+			energy_.damping += (1 - ratio * ratio) * kinetic;
+		}
+		if (!block.rigid) {
+			const Vector6 strain = D.segment<6>(6);
+			energy_.damping += 0.5 * block.volume * strain.dot(block.elasticity() * strain);
+		}
+		for (const PointLoad& load : block.loads)
+			energy_.loads += load.force.dot(displacementAt(load.position - block.centroid, D));
+		for (const FixedPoint& point : block.fixedPoints) {
+			const double stiffness = point.stiffness > 0 ? point.stiffness
+			                                             : settings.fixedPointPenaltyFactor * block.material.young * block.size;
+			const Vector3 u = displacementAt(point.position - block.centroid, D);
+			energy_.loads += stiffness * (point.anchor - point.position - u).dot(u);
+		}
+	}
+	// Contacts: their springs' energy at the start of this step in the
+	// accepted states against what the last step ended with.
+	double start = 0, end = 0;
+	for (Contact& contact : store_.contacts()) {
+		const int bi = contact.key.blockI, bj = contact.key.blockJ;
+		const ContactStepEnergy e = contactStepEnergy(contact, blocks_[bi], blocks_[bj], solutionOf(bi), solutionOf(bj));
+		if (std::getenv("DDA_DEBUG_JUMPS")) {
+			const double before = contact.isNew ? 0.0 : contact.history.energy;
+			if (std::abs(e.start - before) > 1.0)
+				std::fprintf(stderr, "jump step %ld contact %d-%d kind %d new %d state %d hist %d d0 %.3e start %.4e before %.4e type %d\n",
+				             steps_, bi, bj, int(contact.key.kind), int(contact.isNew), int(contact.trial.state),
+				             int(contact.history.state), contact.normal.d0, e.start, before, int(contact.pairType));
+		}
+		contact.trial.energy = e.end;
+		start += e.start;
+		end += e.end;
+		energy_.damping += e.damping;
+		energy_.friction += e.friction;
+		if (std::getenv("DDA_DEBUG_ENERGY")) {
+			Matrix24 K;
+			Vector24 f;
+			if (contactTerms(contact, blocks_[bi], blocks_[bj], K, f)) {
+				Vector24 D;
+				D << solutionOf(bi), solutionOf(bj);
+				double work = (f - K * D).dot(D);
+				const double predicted = -(e.end - e.start) - e.damping - e.friction;
+				if (std::abs(work - predicted) > 1.0)
+					std::fprintf(stderr, "step %ld contact %d-%d kind %d state %d bonded %d new %d d0 %.3e d1 %.3e work %.4e predicted %.4e\n",
+					             steps_, bi, bj, int(contact.key.kind), int(contact.trial.state), int(contact.trial.bonded),
+					             int(contact.isNew), contact.normal.d0, contactGap(contact, solutionOf(bi), solutionOf(bj)), work, predicted);
+			}
+		}
+	}
+	energy_.contactChanges += start - energy_.contact;
+	energy_.contact = end;
 }
 
 double World::step(const IntegratorSettings& settings) {
@@ -603,8 +866,6 @@ double World::step(const IntegratorSettings& settings) {
 	detectContacts(settings, stats);
 	std::vector<Contact>& contacts = store_.contacts();
 
-	const double openTolerance = settings.openCloseTolerance * stats.allowedDisplacement;
-	const double holdClosedGap = std::max(openTolerance, kHoldClosedFraction * stats.allowedDisplacement);
 	double dt = nextTimeStep_ > 0 ? std::min(nextTimeStep_, settings.maxTimeStep) : settings.maxTimeStep;
 
 	for (int attempt = 0;; ++attempt) {
@@ -615,15 +876,43 @@ double World::step(const IntegratorSettings& settings) {
 		// assembleBlock adds a body force only for non-zero gravity.
 		if (!settings.gravity.isZero()) stats.bodyForceBlocks += n;
 
-		// Open-close iteration: solve with the trial contact states, update the
-		// states from the solution, until no state changes.
+		// Open-close iteration: Newton's method on the step's energy (the
+		// blocks' quadratic energy plus every contact's compression-only
+		// normal spring and Coulomb-limited tangential spring; see
+		// ContactEquations.hpp), in passes. Within a pass each contact's
+		// friction limit is fixed, so the energy is one convex function:
+		// each solve minimises the contacts' model at the states of the
+		// current iterate, the states are evaluated at the new iterate, and
+		// once a contact has swung back (or the pass runs long) a line search
+		// makes every iterate lower the energy, so the pass cannot cycle. A
+		// pass has converged when no state changes and the slipping
+		// contacts' forces agree with their model: every closed contact is
+		// then in compression and every open one apart, exactly the
+		// gradients the energy account books, so the step creates no energy
+		// (World::accountStep). Then the limits are set from the normal
+		// forces found, and another pass is made while they change by more
+		// than kLimitTolerance (at most kLimitPasses). The hold-closed and
+		// friction-switch rules this replaces held contacts in tension and
+		// created energy (a stiff pile gained up to 36%).
+		iterate_.assign(n, Vector12::Zero());
 		for (Contact& contact : contacts) {
 			startTrial(contact, steps_ == 0);
-			contact.frictionSwitches = 0;
-			contact.openCloseSwitches = 0;
 			const int bi = contact.key.blockI, bj = contact.key.blockJ;
-			startSlidingIfMoving(contact, blocks_[bi], blocks_[bj], startVelocityOf(bi, settings), startVelocityOf(bj, settings), dt);
+			// The first pass's limit from the normal force at the start of
+			// the step (its gap now), not the one the contact ended the last
+			// step with: a corner that bounced off keeps no friction.
+			evaluateContact(contact, blocks_[bi], blocks_[bj], solutionOf(bi), solutionOf(bj));
+			updateFrictionLimit(contact, true);
+			evaluateContact(contact, blocks_[bi], blocks_[bj], solutionOf(bi), solutionOf(bj));
 		}
+		// The blocks that contacts join (open ones too: their energy counts
+		// once they close) form groups whose energies are independent: each
+		// group iterates, searches and converges on its own, so a block
+		// elsewhere in the scene cannot change another's trajectory, not even
+		// by round-off. A converged group's iterate is no longer moved.
+		groupContacts();
+		group_.reset(n);
+		for (const Contact& contact : contacts) group_.hasContacts[contactGroup_[&contact - contacts.data()]] = 1;
 		bool converged = false, structureStale = true;
 		int iterations = 0, changes = 0;
 		while (iterations < std::max(1, settings.maxOpenCloseIterations)) {
@@ -642,87 +931,96 @@ double World::step(const IntegratorSettings& settings) {
 			if (rebuilt) solveAloneBlocks(settings, dt);
 			coupled_.solve(solutions_, kMinBlocksForThreads);
 			stats.solvedUnknowns = coupled_.solvedUnknowns() + aloneUnknowns_;
+			if (lineSearch(settings, dt) < 1) ++stats.lineSearches;
 			stats.timeSolve += secondsSince(phase);
 			++iterations;
-			changes = 0;
-			double normalForceChange = 0, largestNormalForce = 0;
-			for (Contact& contact : contacts) {
+			group_.startIteration();
+			for (std::size_t c = 0; c < contacts.size(); ++c) {
+				Contact& contact = contacts[c];
+				const int g = contactGroup_[c];
+				if (group_.done[g]) continue;
 				const int bi = contact.key.blockI, bj = contact.key.blockJ;
-				const ContactHistory before = contact.trial;
-				if (contact.trial.state != ContactState::Open)
-					largestNormalForce = std::max(largestNormalForce, std::abs(contact.trial.normalForce));
-				if (!updateContactState(contact, blocks_[bi], blocks_[bj], solutionOf(bi), solutionOf(bj), openTolerance)) {
-					if (contact.trial.state == ContactState::Sliding && contact.frictionTangent > 0)
-						normalForceChange = std::max(normalForceChange,
-						                             std::abs(contact.trial.normalForce - before.normalForce));
-					continue;
-				}
-				const bool frictionSwitch =
-				    before.state != ContactState::Open && contact.trial.state != ContactState::Open;
-				if (!frictionSwitch) {
-					// A contact that has opened and closed again in this
-					// iteration and would open once more cycles: closed, the
-					// solve leaves it a hair apart (in tension); open, the
-					// corner falls in (a block rocking between two supports of
-					// a pile). Held closed when its gap is within
-					// kHoldClosedFraction of the allowed step displacement: the
-					// spring then holds a tension of at most kn x that gap for
-					// this one step, stores kn gap^2 / 2 and gives it back
-					// when it opens next step. Opened instead, the corner would
-					// sink up to a step's motion into the other block and be
-					// pushed out with the energy of that penetration; cutting
-					// dt (what the iteration did before) costs a redo and
-					// often cycled again at the smaller dt.
-					if (contact.trial.state == ContactState::Open && !before.bonded &&
-					    contact.openCloseSwitches >= kOpenCloseSwitchesCounted &&
-					    contactGap(contact, solutionOf(bi), solutionOf(bj)) <= holdClosedGap) {
-						contact.trial = before;
-						++stats.openCloseHeld;
-						continue;
+				const Vector12& Di = solutionOf(bi);
+				const Vector12& Dj = solutionOf(bj);
+				const Vector3 model = tangentialForce(contact, blocks_[bi], blocks_[bj], Di, Dj);
+				const bool wasClosed = isClosed(contact);
+				if (evaluateContact(contact, blocks_[bi], blocks_[bj], Di, Dj)) {
+					++group_.changes[g];
+					// Only closed contacts carry normal terms: opening and
+					// closing change which blocks the system couples.
+					if (wasClosed != isClosed(contact)) {
+						structureStale = true;
+						if (++contact.openCloseChanges >= 2) group_.swungBack[g] = 1;
 					}
-					++contact.openCloseSwitches;
-					// Opening and closing always count, and change which blocks
-					// the system couples (only closed contacts carry terms).
-					structureStale = true;
-					++changes;
+				}
+				// A contact that closes with no limit takes the limit of its
+				// normal force now, once per pass (so the pass's energy changes
+				// a finite number of times): frictionless until the next pass,
+				// a block landing on a much larger one was held sideways by its
+				// inertia alone, and the system's Cholesky failed on round-off
+				// at five decades of scale.
+				if (isClosed(contact) && !(contact.slipLimit > 0) && contact.trial.normalForce > 0 &&
+				    contact.frictionTangent > 0) {
+					updateFrictionLimit(contact, true);
+					evaluateContact(contact, blocks_[bi], blocks_[bj], Di, Dj);
+					++group_.changes[g];
+				}
+				group_.largestNormalForce[g] = std::max(group_.largestNormalForce[g], std::abs(contact.trial.normalForce));
+				group_.forceChange[g] = std::max(
+				    group_.forceChange[g], (tangentialForce(contact, blocks_[bi], blocks_[bj], Di, Dj) - model).norm());
+			}
+			// Groups whose pass converged: their limits against the normal
+			// forces found; done when they agree, else another pass.
+			for (std::size_t c = 0; c < contacts.size(); ++c) {
+				const int g = contactGroup_[c];
+				if (group_.done[g] || !group_.passConverged(g, kNormalForceTolerance)) continue;
+				const double target = updateFrictionLimit(contacts[c], false);
+				group_.limitChange[g] = std::max(group_.limitChange[g], target);
+				group_.largestLimit[g] = std::max(group_.largestLimit[g], contacts[c].slipLimit + target);
+			}
+			changes = 0;
+			bool allDone = true;
+			for (int g = 0; g < n; ++g) {
+				if (group_.done[g]) continue;
+				changes += group_.changes[g];
+				if (!group_.hasContacts[g]) {
+					group_.done[g] = 1;  // no contact: its own solve is its answer
 					continue;
 				}
-				// A closed contact that keeps switching between sliding and
-				// locked within one step sits on the friction limit, where
-				// round-off decides. After kFrictionSwitchesCounted switches it
-				// stays locked: a switch back to sliding is undone, so the state
-				// is the one the last solve was made for (accepting the switch
-				// unsolved would load the step with friction along a motion
-				// that reversed, creating energy); a switch to locked counts,
-				// and one more solve is made for it. A locked spring stores
-				// energy and never creates it; any excess over the friction
-				// limit is released by the next step, which starts locked and
-				// slides.
-				if (contact.frictionSwitches >= kFrictionSwitchesCounted &&
-				    contact.trial.state == ContactState::Sliding) {
-					contact.trial = before;
+				if (!group_.passConverged(g, kNormalForceTolerance)) {
+					allDone = false;
 					continue;
 				}
-				++contact.frictionSwitches;
-				++changes;
+				const bool settled = group_.limitChange[g] <= kLimitTolerance * group_.largestLimit[g];
+				if (settled || group_.passes[g] + 1 >= kLimitPasses) {
+					group_.done[g] = 1;
+					if (!settled) ++stats.limitsUnsettled;
+					continue;
+				}
+				allDone = false;
+				group_.newPass[g] = 1;
+				++group_.passes[g];
+				group_.passSolves[g] = 0;
+				++stats.limitPasses;
 			}
-			// A sliding contact's friction load tan(phi) N used the normal
-			// force of the solve before. A solve with springs locked can tip a
-			// block and give N many times its weight, so the iteration goes on
-			// while a sliding contact's N changes by more than a fraction of
-			// the largest normal force, for at most kNormalForceSolves solves:
-			// a lagging N changes how much friction resists, never its
-			// direction against the sliding, so it cannot create energy.
-			if (changes == 0 && iterations < kNormalForceSolves &&
-			    normalForceChange > kNormalForceTolerance * largestNormalForce) {
-				++stats.normalForceUpdates;
-				continue;
-			}
-			if (changes == 0) {
+			if (std::getenv("DDA_DEBUG_ITER"))
+				std::fprintf(stderr, "step %ld attempt %d it %d changes %d\n", steps_, attempt, iterations, changes);
+			if (allDone) {
 				converged = true;
 				break;
 			}
+			for (std::size_t c = 0; c < contacts.size(); ++c) {
+				Contact& contact = contacts[c];
+				if (!group_.newPass[contactGroup_[c]]) continue;
+				// Which contacts carry terms may change with the limits (an
+				// open contact with a limit keeps its tangential spring).
+				structureStale = true;
+				updateFrictionLimit(contact, true);
+				const int bi = contact.key.blockI, bj = contact.key.blockJ;
+				evaluateContact(contact, blocks_[bi], blocks_[bj], solutionOf(bi), solutionOf(bj));
+			}
 		}
+		solutions_ = iterate_;
 		stats.openCloseIterations = iterations;
 		stats.openCloseIterationsTotal += iterations;
 		stats.stateChanges = changes;
@@ -758,6 +1056,8 @@ double World::step(const IntegratorSettings& settings) {
 		++stats.stepCuts;
 	}
 
+	gravity_ = settings.gravity;
+	accountStep(settings, dt);
 	const auto phase = Clock::now();
 	// Contacts first (forces from the accepted solution, anchors carried along
 	// with their blocks), then the blocks themselves.
@@ -768,7 +1068,7 @@ double World::step(const IntegratorSettings& settings) {
 		finishContact(contact, blocks_[bi], blocks_[bj], solutionOf(bi), solutionOf(bj));
 		ContactHistory& trial = contact.trial;
 		contact.point = movingIndex_[bi] >= 0 ? motions_[movingIndex_[bi]](contact.geometry.pointI) : contact.geometry.pointI;
-		if (trial.state == ContactState::Locked) {
+		if (trial.state != ContactState::Open) {
 			if (movingIndex_[bi] >= 0) trial.anchorI = motions_[movingIndex_[bi]](trial.anchorI);
 			if (movingIndex_[bj] >= 0) trial.anchorJ = motions_[movingIndex_[bj]](trial.anchorJ);
 		}

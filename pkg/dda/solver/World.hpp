@@ -3,6 +3,7 @@
 #pragma once
 
 #include "BlockEquations.hpp"
+#include "ContactEquations.hpp"
 #include "CoupledSystem.hpp"
 #include "IntegratorSettings.hpp"
 #include "dda/block/Block.hpp"
@@ -73,6 +74,8 @@ public:
 		std::size_t collider = 0, contacts = 0, narrowPhase = 0, solver = 0;
 	};
 	MemoryUse memoryUse() const;
+	// The energy account now (EnergyAccount, IntegratorSettings.hpp) [J].
+	EnergyAccount energy() const;
 	double time() const { return time_; }
 	long steps() const { return steps_; }
 	// Sub-contacts of the last step, with their state at its end.
@@ -112,7 +115,31 @@ private:
 	void solveAloneBlocks(const IntegratorSettings& settings, double dt);
 	// Adds the trial-state terms of every contact to coupled_ (counted in stats).
 	void assembleContacts(StepStatistics& stats);
-	// A block's entry of solutions_; zero for fixed blocks.
+	// Adds the accepted step's dissipation, work of loads and contact springs'
+	// changes to the account (energy_), and records the springs' energy at its
+	// end; called before the contacts and blocks are moved.
+	void accountStep(const IntegratorSettings& settings, double dt);
+	// Moves the iterate (iterate_) towards the Newton solution (solutions_)
+	// by the step t in (0, 1] that minimises the step's energy along the way
+	// (1 unless a contact slips or crosses a kink of its energy), per group
+	// of blocks that contacts join (groupContacts), leaving converged groups
+	// where they are; returns the smallest t.
+	double lineSearch(const IntegratorSettings& settings, double dt);
+	// Groups the moving blocks that contacts join (groupRoot_: per moving
+	// block its group's root; contactGroup_: per contact its group).
+	void groupContacts();
+	// Per group of the step's iteration (indexed by root).
+	struct GroupIteration {
+		std::vector<char> done, hasContacts, swungBack, newPass;
+		std::vector<int> passes, passSolves, changes;
+		std::vector<double> forceChange, largestNormalForce, limitChange, largestLimit;
+		void reset(int groups);
+		void startIteration();
+		bool passConverged(int g, double tolerance) const;
+	};
+	GroupIteration group_;
+	std::vector<int> contactGroup_;
+	// A block's entry of the current iterate; zero for fixed blocks.
 	const Vector12& solutionOf(int block) const;
 	// A block's start-of-step velocity (startVelocity); zero for fixed blocks.
 	Vector12 startVelocityOf(int block, const IntegratorSettings& settings) const;
@@ -154,6 +181,11 @@ private:
 	std::vector<Block> blocks_;
 	TopologyPool topologies_;  // the blocks' shared topologies
 	StepStatistics stats_;
+	// The account's cumulative terms (friction, damping, loads,
+	// contactChanges) and the springs' energy at the end of the last step
+	// (contact); gravity of the last step, for the potential.
+	EnergyAccount energy_;
+	Vector3 gravity_ = Vector3::Zero();
 	double nextTimeStep_ = 0;  // dt to try first in the next step; 0 = maxTimeStep
 	double time_ = 0;
 	long steps_ = 0;
@@ -162,7 +194,13 @@ private:
 	int sceneSizedBlocks_ = -1;  // block count when sceneHalfSize_ was measured
 	// per-step work arrays, kept to avoid reallocation
 	std::vector<int> moving_;
-	std::vector<Vector12> solutions_;
+	std::vector<Vector12> solutions_;  // the last Newton solution, per moving block
+	std::vector<Vector12> iterate_;    // the current iterate of the step's iteration
+	std::vector<Vector12> deltas_;     // lineSearch's work arrays
+	std::vector<ContactLine> lines_;
+	std::vector<int> groupRoot_, lineGroup_, groupLines_, lineOrder_;
+	std::vector<char> groupKink_;
+	std::vector<double> groupSlope_, groupCurvature_, groupStep_;
 	// This attempt's own systems of the blocks coupled at some build
 	// (ownSystemOf_: per moving block, its index there, -1 if none), and which
 	// blocks left alone already have their solution.

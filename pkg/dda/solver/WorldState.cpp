@@ -138,6 +138,7 @@ void writeHistory(StateWriter& out, const ContactHistory& h) {
 	out.pod(h.normalForce);
 	out.pod(static_cast<std::uint8_t>(h.bonded));
 	out.matrix(h.shearForce);
+	out.pod(h.energy);
 }
 
 void readHistory(StateReader& in, ContactHistory& h) {
@@ -150,6 +151,7 @@ void readHistory(StateReader& in, ContactHistory& h) {
 	in.pod(h.normalForce);
 	h.bonded = in.pod<std::uint8_t>() != 0;
 	in.matrix(h.shearForce);
+	in.pod(h.energy);
 }
 
 ContactKind readKind(StateReader& in) {
@@ -190,7 +192,6 @@ void writeContact(StateWriter& out, const Contact& c) {
 	for (double x : {c.normalStiffness, c.shearStiffness, c.frictionTangent, c.area, c.cohesionForce, c.tensileForce})
 		out.pod(x);
 	out.pod(static_cast<std::uint8_t>(c.isNew));
-	out.pod(c.frictionSwitches);
 	out.matrix(c.point);
 }
 
@@ -228,7 +229,6 @@ Contact readContact(StateReader& in, int blocks) {
 	for (double* x : {&c.normalStiffness, &c.shearStiffness, &c.frictionTangent, &c.area, &c.cohesionForce, &c.tensileForce})
 		in.pod(*x);
 	c.isNew = in.pod<std::uint8_t>() != 0;
-	in.pod(c.frictionSwitches);
 	in.matrix(c.point);
 	return c;
 }
@@ -257,6 +257,11 @@ void World::writeState(StateWriter& out) const {
 	for (const auto& faces : internalFaces_) out.podVector(faces);
 	out.size(sizeof(StepStatistics));
 	out.pod(stats_);
+	out.tag("ENRG");
+	for (double x : {energy_.kinetic, energy_.gravity, energy_.strain, energy_.contact, energy_.friction,
+	                 energy_.damping, energy_.loads, energy_.contactChanges})
+		out.pod(x);
+	out.matrix(gravity_);
 
 	out.tag("BLKS");
 	out.size(blocks_.size());
@@ -302,6 +307,11 @@ void World::readState(StateReader& in) {
 	} else {
 		for (std::size_t k = 0; k < statsBytes; ++k) in.pod<char>();
 	}
+	in.tag("ENRG");
+	for (double* x : {&w.energy_.kinetic, &w.energy_.gravity, &w.energy_.strain, &w.energy_.contact,
+	                  &w.energy_.friction, &w.energy_.damping, &w.energy_.loads, &w.energy_.contactChanges})
+		in.pod(*x);
+	in.matrix(w.gravity_);
 
 	in.tag("BLKS");
 	w.blocks_.resize(in.size(64, "blocks"));
