@@ -29,7 +29,7 @@ g = 9.81 m/s^2, simulated time tEnd = 1 s, --quick 0.3 s):
 
 Knobs (DDAIntegrator / MSCCollider parameters): dt [s], maxDisplacementRatio [-]
 (with maxDisplacement = 0 and dt = 1e-2 s, so the displacement control sets the
-step), contactPenaltyFactor [-], openCloseTolerance [-], criticalLength [m] and
+step), contactPenaltyFactor [-], criticalLength [m] and
 segments (MSC; accuracy must not change, detection work does). Each knob runs in
 its own process, its points one after another, each with one core thread.
 
@@ -73,8 +73,6 @@ PLAN = {
                                  base=dict(dt=1e-2, maxDisplacement=0.0)),
     'contactPenaltyFactor': dict(full=[1, 3, 10, 40, 100, 300, 1000], quick=[4, 40, 400],
                                  scenes=['incline_friction', 'wedge', 'bounce'], base={}),
-    'openCloseTolerance': dict(full=[1e-12, 1e-9, 1e-6, 1e-3, 1e-2, 0.1, 0.5], quick=[1e-9, 1e-3, 0.1],
-                               scenes=['incline_friction', 'wedge', 'bounce'], base={}),
     'criticalLength': dict(full=[0.0, 0.25, 0.5, 1.0, 2.0, 100.0], quick=[0.0, 0.5],
                            scenes=['incline_friction', 'wedge'], base={}),
     'segments': dict(full=[1, 2, 3, 6, 12], quick=[1, 6], scenes=['incline_friction', 'wedge'], base={}),

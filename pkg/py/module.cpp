@@ -374,7 +374,6 @@ BOOST_PYTHON_MODULE(_core) {
 	    .def_readwrite("shearStiffnessRatio", &IntegratorSettings::shearStiffnessRatio)
 	    .def_readwrite("maxOpenCloseIterations", &IntegratorSettings::maxOpenCloseIterations)
 	    .def_readwrite("openCloseShrink", &IntegratorSettings::openCloseShrink)
-	    .def_readwrite("openCloseTolerance", &IntegratorSettings::openCloseTolerance)
 	    .def_readwrite("threads", &IntegratorSettings::threads)
 	    .def_readwrite("reuseCandidatePairs", &IntegratorSettings::reuseCandidatePairs);
 

@@ -16,7 +16,7 @@ the knob on the scene's engine, runs until ``O.time == tEnd`` exactly
 (``advance``) and calls ``measure()``. Knobs (``KNOBS``) are parameters of
 ``DDAIntegrator`` (``dt`` [s], also spelt ``maxTimeStep``;
 ``maxDisplacementRatio`` [-], ``maxDisplacement`` [m],
-``contactPenaltyFactor`` [-], ``openCloseTolerance`` [-], ...) or of
+``contactPenaltyFactor`` [-], ...) or of
 ``MSCCollider`` (``criticalLength`` [m], ``segments`` [-]; one is inserted
 before the integrator when the scene has none).
 
@@ -53,7 +53,6 @@ KNOBS = {
     'maxDisplacementRatio': ('DDAIntegrator', 'maxDisplacementRatio', '-'),
     'maxDisplacement': ('DDAIntegrator', 'maxDisplacement', 'm'),
     'contactPenaltyFactor': ('DDAIntegrator', 'contactPenaltyFactor', '-'),
-    'openCloseTolerance': ('DDAIntegrator', 'openCloseTolerance', '-'),
     'shearStiffnessRatio': ('DDAIntegrator', 'shearStiffnessRatio', '-'),
     'contactDistance': ('DDAIntegrator', 'contactDistance', 'm'),
     'maxOpenCloseIterations': ('DDAIntegrator', 'maxOpenCloseIterations', '-'),

@@ -144,12 +144,10 @@ class DDAIntegrator(wrapper.PyRunner):
     - ``contactPenaltyFactor`` [-]: normal contact stiffness [N/m] is this x
       the smaller E x size of the two blocks (default 40; Shi: 40-100 x E).
     - ``shearStiffnessRatio`` [-]: shear / normal contact stiffness (0.4).
-    - ``maxOpenCloseIterations``: solves per step before dt is cut (20;
-      Shi's 6 cuts dt too often in 3D stacks).
+    - ``maxOpenCloseIterations``: solves per step before dt is cut (40;
+      the iteration makes passes with fixed friction limits, see README).
     - ``openCloseShrink`` [-]: dt factor for a step whose iteration did not
       converge (0.3).
-    - ``openCloseTolerance`` [-]: a closed contact opens when its gap exceeds
-      this x the allowed step displacement (1e-9).
     - ``collider``: the broad phase, ``'MSC'`` (multi-shell cover, with its
       default cover; use ``MSCCollider`` to set lambda and N), ``'DESS'`` (one
       sorted box per block, default), ``'NBS'`` (one bounding sphere per
@@ -194,7 +192,7 @@ class DDAIntegrator(wrapper.PyRunner):
                                       'contact normal stiffness / min(E x block size) [-]')
     shearStiffnessRatio = _Parameter(0.4, lambda v: _finite('shearStiffnessRatio', v, 0),
                                      'contact shear / normal stiffness [-]')
-    maxOpenCloseIterations = _Parameter(20, _integer('maxOpenCloseIterations', 1),
+    maxOpenCloseIterations = _Parameter(40, _integer('maxOpenCloseIterations', 1),
                                         'open-close iterations before dt is cut')
     openCloseShrink = _Parameter(0.3, lambda v: _finite('openCloseShrink', v, 0, 0.99, lowOpen=True),
                                  'dt factor when the open-close iteration does not converge [-]')
@@ -203,13 +201,11 @@ class DDAIntegrator(wrapper.PyRunner):
                           "'AllPairs' (every pair, the oracle)")
     reuseCandidatePairs = _Parameter(True, lambda v: bool(v),
                                      'diagnostic: reuse broad-phase candidate pairs while blocks rest (same contacts)')
-    openCloseTolerance = _Parameter(1e-9, lambda v: _finite('openCloseTolerance', v, 0),
-                                    'opening gap of a closed contact / allowed step displacement [-]')
 
     _names = ('dt', 'gravity', 'velocityRatio', 'maxDisplacement', 'maxDisplacementRatio', 'timeStepGrowth',
               'maxStepCuts', 'fixedPointPenaltyFactor', 'threads', 'syncPeriod', 'contactDistance',
               'contactPenaltyFactor', 'shearStiffnessRatio', 'maxOpenCloseIterations', 'openCloseShrink',
-              'openCloseTolerance', 'collider',
+              'collider',
               'reuseCandidatePairs')
 
     def __init__(self, label='', **params):
@@ -257,7 +253,6 @@ def _settings(params):
     settings.shearStiffnessRatio = params['shearStiffnessRatio']
     settings.maxOpenCloseIterations = params['maxOpenCloseIterations']
     settings.openCloseShrink = params['openCloseShrink']
-    settings.openCloseTolerance = params['openCloseTolerance']
     settings.reuseCandidatePairs = params['reuseCandidatePairs']
     return settings
 

@@ -439,7 +439,8 @@ void exerciseEquations(Recipe& in, const PairContacts& pair, const Block& a, con
 				requireFinite(force, "contact force");
 			}
 			requireFinite(contactGap(c, Di, Dj), "contact gap");
-			evaluateContact(c, bi, bj, Di, Dj, in.coin());
+			evaluateContact(c, bi, bj, Di, Dj);
+			if (in.coin()) updateFrictionLimit(c, in.coin());
 			checkContact(c);
 			finishContact(c, bi, bj, Di, Dj);
 			checkContact(c);
