@@ -60,6 +60,36 @@ def _points(vertices):
     return points
 
 
+def _nearOrigin(points):
+    """The corners shifted near the origin, exactly, and the shift [m] (None when no axis needs one).
+
+    YADE's Polyhedra joins two hull facets when their planes, as unit 4-vectors
+    (a, b, c, d)/|(a, b, c, d)|, differ by less than 1e-9 (squared norm): far
+    from the origin d dominates and faces at an angle theta merge once their
+    distance from the origin exceeds about theta / 3e-5 m, e.g. a cube's faces
+    from 5e4 m. The joined faces are not planar; YADE's volume, centroid and
+    inertia come out wrong (a turned 1 m cube at 1e4 m: volume 4/3), or the
+    hull collapses to nothing (0 corners, most blocks at 1e5 m). Shifted near
+    the origin, the test sees the block's own dihedral angles. Per axis the
+    shift is the corners' smallest coordinate when all lie within a factor 2 of
+    it (then every difference is exact, Sterbenz), else 0 (the block then
+    reaches within its own extent of the origin on that axis).
+    """
+    shift = []
+    for axis in range(3):
+        lo = min(p[axis] for p in points)
+        hi = max(p[axis] for p in points)
+        if 0 < lo and hi <= 2 * lo:
+            shift.append(lo)
+        elif hi < 0 and lo >= 2 * hi:
+            shift.append(hi)
+        else:
+            shift.append(0.0)
+    if not any(shift):
+        return points, None
+    return [(p[0] - shift[0], p[1] - shift[1], p[2] - shift[2]) for p in points], tuple(shift)
+
+
 def _material(material):
     """Resolves YADE's ways of naming a material: None (default), id, label or instance."""
     if material is None:
@@ -192,7 +222,15 @@ def ddaBlock(vertices, material=None, fixed=False, color=None, velocity=(0, 0, 0
     if color is not None:
         color = _vector(color, 'color')
 
-    body = utils.polyhedron(points, fixed=fixed, wire=wire, color=color, material=mat, mask=mask)
+    # YADE's shape is made from the corners shifted near the origin (see _nearOrigin); the body is then put
+    # back: pos = shift + YADE's centroid (rounded; SceneLink's vertex match allows for it). The shifted
+    # tuples take the place of the corners in what YADE's converter keeps (see _points); the corners
+    # themselves stay with the block's spec until the core has them.
+    yadePoints, shift = _nearOrigin(points)
+    body = utils.polyhedron(yadePoints, fixed=fixed, wire=wire, color=color, material=mat, mask=mask)
+    if shift is not None:
+        pos = body.state.pos
+        body.state.pos = body.state.refPos = (pos[0] + shift[0], pos[1] + shift[1], pos[2] + shift[2])
     if len(body.shape.v) != len(points):
         # YADE's Polyhedra builds its own hull with its own tolerances (absolute ones: a 1e9 m cube lost a corner)
         raise ValueError('YADE\'s Polyhedra shape of this block has %d corners instead of %d (YADE merged corners '
