@@ -9,12 +9,21 @@ from . import scene as _scene
 class BlockSpec:
     """What the core needs to build a block once its body is in O.bodies."""
 
-    __slots__ = ('points', 'density', 'young', 'poisson', 'frictionAngle', 'cohesion', 'tensileStrength', 'fixed',
-                 'rigid', 'fixedPoints', 'loads', 'stress')
+    # points: the corners as given to YADE's Polyhedra, i.e. shifted by `shift` (None: not shifted; see
+    # _nearOrigin). The block's corners are corners(): the shift adds back exactly.
+    __slots__ = ('points', 'shift', 'density', 'young', 'poisson', 'frictionAngle', 'cohesion', 'tensileStrength',
+                 'fixed', 'rigid', 'fixedPoints', 'loads', 'stress')
 
     def __init__(self, **kw):
         for key in self.__slots__:
             setattr(self, key, kw.get(key))
+
+    def corners(self):
+        """The block's corners [m], as given to ddaBlock."""
+        if self.shift is None:
+            return self.points
+        x, y, z = self.shift
+        return [(p[0] + x, p[1] + y, p[2] + z) for p in self.points]
 
 
 def _vector(value, what, length=3):
@@ -76,6 +85,7 @@ def _nearOrigin(points):
     reaches within its own extent of the origin on that axis).
     """
     shift = []
+    # p - shift is exact, so shift + (p - shift) gives p back exactly (BlockSpec.corners).
     for axis in range(3):
         lo = min(p[axis] for p in points)
         hi = max(p[axis] for p in points)
@@ -223,26 +233,26 @@ def ddaBlock(vertices, material=None, fixed=False, color=None, velocity=(0, 0, 0
         color = _vector(color, 'color')
 
     # YADE's shape is made from the corners shifted near the origin (see _nearOrigin); the body is then put
-    # back: pos = shift + YADE's centroid (rounded; SceneLink's vertex match allows for it). The shifted
-    # tuples take the place of the corners in what YADE's converter keeps (see _points); the corners
-    # themselves stay with the block's spec until the core has them.
+    # back: pos = shift + YADE's centroid (rounded; SceneLink's vertex match allows for it). The spec keeps
+    # the shifted tuples, which YADE's converter keeps anyway (see _points), and the shift, not a second copy.
     yadePoints, shift = _nearOrigin(points)
     body = utils.polyhedron(yadePoints, fixed=fixed, wire=wire, color=color, material=mat, mask=mask)
     if shift is not None:
         pos = body.state.pos
         body.state.pos = body.state.refPos = (pos[0] + shift[0], pos[1] + shift[1], pos[2] + shift[2])
     if len(body.shape.v) != len(points):
-        # YADE's Polyhedra builds its own hull with its own tolerances (absolute ones: a 1e9 m cube lost a corner)
+        # YADE's Polyhedra builds its own hull with its own tolerances (absolute ones: a 1e9 m cube lost a
+        # corner). Its distance from the origin no longer matters (the corners were shifted), its size does.
         raise ValueError('YADE\'s Polyhedra shape of this block has %d corners instead of %d (YADE merged corners '
-                         'its own tolerances cannot tell apart); rescale the block or shift its coordinates'
+                         'its own absolute tolerances cannot tell apart, for a block of this size); rescale the block'
                          % (len(body.shape.v), len(points)))
     if not fixed:
         body.state.vel = velocity
         body.state.angVel = angularVelocity
     # Tuples: the spec waits in the scene's pending list until the body is appended, for every block of a
     # scene built in one go, and an empty tuple is one shared object where an empty list is 56 bytes a block.
-    spec = BlockSpec(points=points, density=density, young=young, poisson=poisson, frictionAngle=frictionAngle,
-                     cohesion=cohesion, tensileStrength=tensileStrength, fixed=bool(fixed), rigid=rigid,
+    spec = BlockSpec(points=yadePoints, shift=shift, density=density, young=young, poisson=poisson,
+                     frictionAngle=frictionAngle, cohesion=cohesion, tensileStrength=tensileStrength, fixed=bool(fixed), rigid=rigid,
                      fixedPoints=tuple(fixedList), loads=tuple(loadList), stress=stress)
     _scene.current().register(body, spec)
     return body

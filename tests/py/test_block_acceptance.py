@@ -131,6 +131,8 @@ def _dropFarApart(count, seed):
         made.append((O.bodies.append(body), corners, velocity))
     O.engines = [DDAIntegrator(dt=1e-3, gravity=(0, 0, -G), maxDisplacement=0.01, label='dda')]
     start = {b: (np.array(yade_dda.block(b).vertices), np.array(yade_dda.block(b).centroid)) for b, _, _ in made}
+    for bodyId, corners, _ in made:   # the corners reach the core exactly (YADE's shape was made from shifted ones)
+        assert sorted(map(tuple, start[bodyId][0].tolist())) == sorted(corners), bodyId
     O.run(STEPS, True)
     t = yade_dda.scene.current().core.time()
     assert t > 0
