@@ -19,10 +19,12 @@ namespace dda {
 //     turn, at offsets 0 to 1e6 m).
 // The tolerance is eps (kPositionRoundoff |pos| + kFrameRoundoff r), r the
 // largest corner distance from the centroid: 8 and 25 times those bounds.
-// The core's centroid is not used: YADE's may differ from it by round-off
-// (|pos| eps, which beat the old 1e-9 x size for small blocks far from the
-// origin) and, before blocks.py shifted the corners, by up to 25% of the block
-// (YADE merged faces that were not coplanar far from the origin).
+// The core's centroid is not used: YADE's differs from it by its own
+// round-off, measured up to ~10 |pos| eps and, on turned 1000:1 blocks at any
+// offset, 3.8e-11 x the diagonal: beyond the old tolerance 1e-9 x size (size
+// the cube root of the volume, 7e-12 x the diagonal of a 1000:1 prism), which
+// refused 6% of them; and, before blocks.py shifted the corners, by up to 25%
+// of the block (YADE merged faces that were not coplanar far from the origin).
 // Criterion: each body vertex is matched to the nearest unmatched block vertex
 // within the tolerance, pairs taken nearest first, and every vertex must be
 // matched (a bijection: the counts are equal). A bound derived from "well
@@ -63,7 +65,7 @@ void SceneLink::link(int blockIndex, int bodyId, const Vector3& position0, const
 	for (std::size_t k = 0; k < n; ++k)
 		for (std::size_t j = 0; j < n; ++j) {
 			const double d = (blockLocal[j] - localVertices[k]).norm();
-			if (!(d >= nearest[k])) {  // also takes a NaN distance, so it is reported
+			if (nearestVertex[k] < 0 || d < nearest[k]) {  // a NaN distance never matches: reported below
 				nearest[k] = d;
 				nearestVertex[k] = static_cast<int>(j);
 			}
