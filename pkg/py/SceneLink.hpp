@@ -31,9 +31,18 @@ public:
 
 	World world;
 
-	// Matches the body's local vertices to the block's by position (each within
-	// 1e-9 x block size, else std::invalid_argument).
-	void link(int block, int bodyId, const Eigen::Quaterniond& orientation0, const std::vector<Vector3>& localVertices);
+	// Round-off factors of the vertex match (SceneLink.cpp, link): the
+	// tolerance is eps (kPositionRoundoff |pos| + kFrameRoundoff r), r the
+	// largest distance of a corner from the centroid [m].
+	static constexpr double kPositionRoundoff = 4;
+	static constexpr double kFrameRoundoff = 64;
+
+	// Matches the body's vertices (local, in the frame at position0 turned by
+	// orientation0: the body's state.pos and state.ori) one to one to the
+	// block's corners, each within the round-off tolerance above; else
+	// std::invalid_argument naming the vertex, the distance and the tolerance.
+	void link(int block, int bodyId, const Vector3& position0, const Eigen::Quaterniond& orientation0,
+	          const std::vector<Vector3>& localVertices);
 	const BodyLink* bodyLink(int block) const;
 	BodyLink* bodyLink(int block);
 	int blockOfBody(int bodyId) const;

@@ -74,8 +74,9 @@ py::list contactList(const SceneLink& s) {
 	return out;
 }
 
-void linkBody(SceneLink& scene, int block, int bodyId, const Eigen::Quaterniond& orientation, const py::object& localVertices) {
-	scene.link(block, bodyId, orientation, toPoints(localVertices, "body vertices"));
+void linkBody(SceneLink& scene, int block, int bodyId, const Vector3& position, const Eigen::Quaterniond& orientation,
+              const py::object& localVertices) {
+	scene.link(block, bodyId, position, orientation, toPoints(localVertices, "body vertices"));
 }
 
 py::list blockVertices(const SceneLink& scene, int i) { return toList(scene.world.block(i).vertices); }
@@ -146,17 +147,20 @@ double step(SceneLink& s, const IntegratorSettings& settings) {
 
 // Per moving block linked to a body (and fixed ones once): (bodyId, pos, ori, vel, angVel, vertices or None).
 // Vertices are in the body's local frame, in the body's vertex order, and are
-// sent only when the block's strain changed since the last sync.
+// sent at a block's first sync (YADE's frame is at YADE's centroid, the sync's
+// at the core's: they differ by round-off) and then only when the block's
+// strain changed since the last sync.
 py::list syncData(SceneLink& s, bool all) {
 	py::list out;
 	for (int i = 0; i < s.world.blockCount(); ++i) {
 		Block& b = s.world.block(i);
 		BodyLink* link = s.bodyLink(i);
 		if (!link || (b.fixed && link->synced && !all)) continue;
+		const bool first = !link->synced;
 		link->synced = true;
 		const Eigen::Quaterniond ori = s.bodyOrientation(i);
 		py::object vertices;
-		if (all || b.unsyncedStrain > SceneLink::kVertexSyncStrain) {
+		if (all || first || b.unsyncedStrain > SceneLink::kVertexSyncStrain) {
 			vertices = toList(s.localVertices(i));
 			b.unsyncedStrain = 0;
 		}

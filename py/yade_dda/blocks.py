@@ -9,12 +9,21 @@ from . import scene as _scene
 class BlockSpec:
     """What the core needs to build a block once its body is in O.bodies."""
 
-    __slots__ = ('points', 'density', 'young', 'poisson', 'frictionAngle', 'cohesion', 'tensileStrength', 'fixed',
-                 'rigid', 'fixedPoints', 'loads', 'stress')
+    # points: the corners as given to YADE's Polyhedra, i.e. shifted by `shift` (None: not shifted; see
+    # _nearOrigin). The block's corners are corners(): the shift adds back exactly.
+    __slots__ = ('points', 'shift', 'density', 'young', 'poisson', 'frictionAngle', 'cohesion', 'tensileStrength',
+                 'fixed', 'rigid', 'fixedPoints', 'loads', 'stress')
 
     def __init__(self, **kw):
         for key in self.__slots__:
             setattr(self, key, kw.get(key))
+
+    def corners(self):
+        """The block's corners [m], as given to ddaBlock."""
+        if self.shift is None:
+            return self.points
+        x, y, z = self.shift
+        return [(p[0] + x, p[1] + y, p[2] + z) for p in self.points]
 
 
 def _vector(value, what, length=3):
@@ -58,6 +67,37 @@ def _points(vertices):
         # 26 MB on 50,000 boxes). A point that is already a tuple of 3 floats is passed on as it is.
         points.append(p if type(p) is tuple and all(type(x) is float for x in p) else tuple(coords))
     return points
+
+
+def _nearOrigin(points):
+    """The corners shifted near the origin, exactly, and the shift [m] (None when no axis needs one).
+
+    YADE's Polyhedra joins two hull facets when their planes, as unit 4-vectors
+    (a, b, c, d)/|(a, b, c, d)|, differ by less than 1e-9 (squared norm): far
+    from the origin d dominates and faces at an angle theta merge once their
+    distance from the origin exceeds about theta / 3e-5 m, e.g. a cube's faces
+    from 5e4 m. The joined faces are not planar; YADE's volume, centroid and
+    inertia come out wrong (a turned 1 m cube at 1e4 m: volume 4/3), or the
+    hull collapses to nothing (0 corners, most blocks at 1e5 m). Shifted near
+    the origin, the test sees the block's own dihedral angles. Per axis the
+    shift is the corners' smallest coordinate when all lie within a factor 2 of
+    it (then every difference is exact, Sterbenz), else 0 (the block then
+    reaches within its own extent of the origin on that axis).
+    """
+    shift = []
+    # p - shift is exact, so shift + (p - shift) gives p back exactly (BlockSpec.corners).
+    for axis in range(3):
+        lo = min(p[axis] for p in points)
+        hi = max(p[axis] for p in points)
+        if 0 < lo and hi <= 2 * lo:
+            shift.append(lo)
+        elif hi < 0 and lo >= 2 * hi:
+            shift.append(hi)
+        else:
+            shift.append(0.0)
+    if not any(shift):
+        return points, None
+    return [(p[0] - shift[0], p[1] - shift[1], p[2] - shift[2]) for p in points], tuple(shift)
 
 
 def _material(material):
@@ -192,19 +232,27 @@ def ddaBlock(vertices, material=None, fixed=False, color=None, velocity=(0, 0, 0
     if color is not None:
         color = _vector(color, 'color')
 
-    body = utils.polyhedron(points, fixed=fixed, wire=wire, color=color, material=mat, mask=mask)
+    # YADE's shape is made from the corners shifted near the origin (see _nearOrigin); the body is then put
+    # back: pos = shift + YADE's centroid (rounded; SceneLink's vertex match allows for it). The spec keeps
+    # the shifted tuples, which YADE's converter keeps anyway (see _points), and the shift, not a second copy.
+    yadePoints, shift = _nearOrigin(points)
+    body = utils.polyhedron(yadePoints, fixed=fixed, wire=wire, color=color, material=mat, mask=mask)
+    if shift is not None:
+        pos = body.state.pos
+        body.state.pos = body.state.refPos = (pos[0] + shift[0], pos[1] + shift[1], pos[2] + shift[2])
     if len(body.shape.v) != len(points):
-        # YADE's Polyhedra builds its own hull with its own tolerances (absolute ones: a 1e9 m cube lost a corner)
+        # YADE's Polyhedra builds its own hull with its own tolerances (absolute ones: a 1e9 m cube lost a
+        # corner). Its distance from the origin no longer matters (the corners were shifted), its size does.
         raise ValueError('YADE\'s Polyhedra shape of this block has %d corners instead of %d (YADE merged corners '
-                         'its own tolerances cannot tell apart); rescale the block or shift its coordinates'
+                         'its own absolute tolerances cannot tell apart, for a block of this size); rescale the block'
                          % (len(body.shape.v), len(points)))
     if not fixed:
         body.state.vel = velocity
         body.state.angVel = angularVelocity
     # Tuples: the spec waits in the scene's pending list until the body is appended, for every block of a
     # scene built in one go, and an empty tuple is one shared object where an empty list is 56 bytes a block.
-    spec = BlockSpec(points=points, density=density, young=young, poisson=poisson, frictionAngle=frictionAngle,
-                     cohesion=cohesion, tensileStrength=tensileStrength, fixed=bool(fixed), rigid=rigid,
+    spec = BlockSpec(points=yadePoints, shift=shift, density=density, young=young, poisson=poisson,
+                     frictionAngle=frictionAngle, cohesion=cohesion, tensileStrength=tensileStrength, fixed=bool(fixed), rigid=rigid,
                      fixedPoints=tuple(fixedList), loads=tuple(loadList), stress=stress)
     _scene.current().register(body, spec)
     return body

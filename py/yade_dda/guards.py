@@ -98,7 +98,7 @@ def checkInitialOverlaps(scene, settings):
     count = scene.core.blockCount()
     if not ready and first >= count:
         return
-    added = [(spec.points, spec.density, spec.young, spec.poisson, spec.fixed) for _, spec in ready]
+    added = [(spec.corners(), spec.density, spec.young, spec.poisson, spec.fixed) for _, spec in ready]
     overlaps = scene.core.initialOverlaps(first, added, settings)
     if overlaps:
         def bodyOf(index):

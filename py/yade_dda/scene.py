@@ -46,9 +46,9 @@ class DDAScene:
             if body.id < 0:
                 waiting.append((body, spec))   # made but not (yet) appended: not simulated
                 continue
-            index = self.core.addBlock(spec.points, spec.density, spec.young, spec.poisson, spec.frictionAngle,
+            index = self.core.addBlock(spec.corners(), spec.density, spec.young, spec.poisson, spec.frictionAngle,
                                        spec.cohesion, spec.tensileStrength, spec.fixed, bool(spec.rigid))
-            self.core.linkBody(index, body.id, body.state.ori, list(body.shape.v))
+            self.core.linkBody(index, body.id, body.state.pos, body.state.ori, list(body.shape.v))
             # The body's state is read here, so a script may still set
             # b.state.vel / b.state.angVel between ddaBlock() and the first step.
             if not spec.fixed:
