@@ -1027,6 +1027,70 @@ TEST(ContactDetection, EdgeCrossingsOfBlocksApartAreNeverDeep) {
 	}
 }
 
+// Two pairs of the 50,000-block slender deposit (bodies 22145/22146, a
+// hexahedron and a triangular prism 5.65 mm apart; 44194/45600, 6.5 mm apart:
+// /work/shared/repro/ghost_pairs.json, corners in m), with World's settings
+// for d0 = 1 cm. Their best axis is an edge pair whose edges do not cross
+// strictly inside, so the entrance falls back to the best face, which lies
+// 0.16 and 0.11 m deep; its separation was taken as the depth bound, and the
+// pairs got an edge-edge sub-contact 0.25 m deep (closed, locked, 5.1e7 N)
+// and a vertex-face one 2.6 mm deep. Every sub-contact of a pair apart must
+// have a positive gap, and the pairs, within d0, must keep a contact: the
+// ends of the fallback's edges against their own entrance faces.
+TEST(ContactDetection, GhostPairsOfTheDepositHaveNoNegativeGap) {
+	const std::vector<std::vector<Vector3>> blocks = {
+	    {{18.925986157, 6.450697633, 17.003494633},
+	     {18.838917728, 6.428241197, 16.752056349},
+	     {19.381541205, 5.968348375, 16.832063324},
+	     {19.294472776, 5.945891939, 16.580625039},
+	     {19.746758846, 7.13273078, 16.497382015},
+	     {19.659690417, 7.110274345, 16.24594373},
+	     {20.202313894, 6.650381522, 16.325950706},
+	     {20.115245465, 6.627925087, 16.074512421}},
+	    {{20.220258301, 5.706508503, 16.327361119},
+	     {19.750287835, 6.132223302, 16.25940593},
+	     {20.014291509, 5.858464939, 16.561993541},
+	     {21.309794737, 6.934980369, 16.488183383},
+	     {20.839824271, 7.360695168, 16.420228194},
+	     {21.103827946, 7.086936805, 16.722815806}},
+	    {{15.876995769, 10.467384398, 32.625686741},
+	     {15.96078133, 10.325168142, 32.677523562},
+	     {16.503924233, 10.974056481, 33.193784437},
+	     {16.587709793, 10.831840226, 33.245621259},
+	     {16.49784601, 10.219282278, 31.773819417},
+	     {16.58163157, 10.077066022, 31.825656238},
+	     {17.124774473, 10.725954362, 32.341917114},
+	     {17.208560033, 10.583738106, 32.393753935}},
+	    {{17.171292881, 11.473600174, 33.859889617},
+	     {16.97806806, 10.728634305, 33.407046159},
+	     {16.987206688, 11.21649584, 33.964439189},
+	     {15.984836048, 12.105948105, 33.325875682},
+	     {15.791611227, 11.360982237, 32.873032224},
+	     {15.800749855, 11.848843772, 33.430425254}}};
+	const std::vector<double> apart = {5.6e-3, 6.4e-3};  // below their separating axes' 5.65 and 6.5 mm [m]
+	for (int p = 0; p < 2; ++p) {
+		SCOPED_TRACE("pair " + std::to_string(p));
+		ASSERT_GT(bruteForceSeparation(makeBlock(blocks[2 * p]), makeBlock(blocks[2 * p + 1])), apart[p]);
+		const dda::Block a = dda::makeBlock(blocks[2 * p], dda::Material{}, false);
+		const dda::Block b = dda::makeBlock(blocks[2 * p + 1], dda::Material{}, false);
+		for (const double allowed : {0.0, 0.004}) {  // before the first step, and the deposit's
+			const DetectionSettings settings =
+			    dda::pairDetectionSettings(dda::boundingDiagonal(a), dda::boundingDiagonal(b), 0.01, allowed);
+			for (const bool swap : {false, true}) {
+				const dda::BlockGeometry ga{a.shape.get(), &a.vertices, a.centroid};
+				const dda::BlockGeometry gb{b.shape.get(), &b.vertices, b.centroid};
+				const auto result =
+				    swap ? dda::detectPairContacts(gb, ga, settings) : dda::detectPairContacts(ga, gb, settings);
+				ASSERT_TRUE(result.has_value()) << "a pair within d0 not reported";
+				EXPECT_FALSE(result->contacts.empty()) << "a pair within d0 without sub-contacts";
+				for (const SubContact& c : result->contacts)
+					EXPECT_GE(c.gap, -settings.lengthTolerance)
+					    << "a sub-contact " << c.gap << " m deep between blocks apart";
+			}
+		}
+	}
+}
+
 // A cube tilted 0.004 rad and turned 0.3 rad over a fixed unit cube, its
 // lowest corner overhanging the fixed cube's edge x = 1 so that the pair's
 // closest features are two edges crossing (an edge entrance). Its far
