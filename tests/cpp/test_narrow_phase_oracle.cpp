@@ -318,6 +318,7 @@ struct Counts {
 	long overlapping = 0, apart = 0;
 	long withinContactDistance = 0, reported = 0, reportedBeyond = 0, subContacts = 0;  // beyond: S > d0
 	long tooDeep = 0, negativeApart = 0, missed = 0, emptyWithin = 0;
+	long withPrevious = 0, tooDeepWithPrevious = 0;  // the calls with a previous entrance
 	double worstExcess = 0;  // deepest (S - tolerance) - gap over the pairs [m]
 };
 
@@ -446,15 +447,48 @@ TEST(NarrowPhaseOracle, RandomNearPairsAgainstExactSeparationAndDistance) {
 			       what.str() + "entrance kind " + std::to_string(result->entrance.kind) + " separation " +
 			           std::to_string(result->separation) + (swap ? " (called as B, A)" : ""));
 		}
+		// Every 4th pair again with a random previous entrance (a face of
+		// either block or an edge pair), as World passes the last step's: Shi's
+		// rule keeps it while within `hysteresis` of the best axis, so the
+		// bound is min(S - hysteresis, 0) - tolerance.
+		if (index % 4 == 3) {
+			++n.withPrevious;
+			dda::EntranceFeature previous;
+			const auto pick = [&](std::size_t count) {
+				return static_cast<int>(std::min<double>(unit(rng) * static_cast<double>(count), count - 1.0));
+			};
+			const dda::PolyhedronTopology& first = (swap ? B : A).shape->polyhedron;
+			const dda::PolyhedronTopology& second = (swap ? A : B).shape->polyhedron;
+			const int kind = pick(3);
+			if (kind == 0) previous = {dda::EntranceFeature::FaceOfA, pick(first.faces.size()), -1};
+			if (kind == 1) previous = {dda::EntranceFeature::FaceOfB, pick(second.faces.size()), -1};
+			if (kind == 2) previous = {dda::EntranceFeature::EdgePair, pick(first.edges.size()), pick(second.edges.size())};
+			const std::optional<dda::PairContacts> kept =
+			    swap ? dda::detectPairContacts(geometryB, geometryA, settings, previous)
+			         : dda::detectPairContacts(geometryA, geometryB, settings, previous);
+			if (!kept) continue;
+			const double bound = std::min(static_cast<double>(s) - settings.hysteresis, 0.0) - tolerance;
+			for (const dda::SubContact& c : kept->contacts) {
+				if (c.gap >= bound) continue;
+				++n.tooDeepWithPrevious;
+				report(index, A, B, s, d,
+				       "with previous entrance (" + std::to_string(previous.kind) + ", " +
+				           std::to_string(previous.feature) + ", " + std::to_string(previous.other) +
+				           "): sub-contact gap " + std::to_string(c.gap) + " m below min(S - hysteresis, 0) - tolerance");
+				break;
+			}
+		}
 	}
 	const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 	std::printf(
 	    "narrow-phase oracle, seed %lu: %ld pairs (%ld shapes unbuilt, %ld targets unreachable), %ld overlapping, %ld "
 	    "apart; %ld within d0, %ld reported (%ld beyond d0), %ld sub-contacts\n"
 	    "  failures: %ld too deep (%ld of them negative between blocks apart), %ld missed within d0, %ld within d0 "
-	    "without sub-contacts; worst excess %.3g m; %.1f s (%.1f us per pair)\n",
+	    "without sub-contacts; worst excess %.3g m; with a previous entrance (%ld calls): %ld too deep; %.1f s (%.1f "
+	    "us per pair)\n",
 	    seed, n.pairs, n.unbuilt, n.unplaced, n.overlapping, n.apart, n.withinContactDistance, n.reported,
-	    n.reportedBeyond, n.subContacts, n.tooDeep, n.negativeApart, n.missed, n.emptyWithin, n.worstExcess, seconds,
+	    n.reportedBeyond, n.subContacts, n.tooDeep, n.negativeApart, n.missed, n.emptyWithin, n.worstExcess,
+	    n.withPrevious, n.tooDeepWithPrevious, seconds,
 	    1e6 * seconds / std::max<long>(n.pairs, 1));
 	std::fflush(stdout);
 	// The sampling must reach both classes and the contact band.
@@ -466,4 +500,6 @@ TEST(NarrowPhaseOracle, RandomNearPairsAgainstExactSeparationAndDistance) {
 	EXPECT_EQ(n.tooDeep, 0) << "sub-contacts deeper than the pair's overlap (seed " << seed << ")";
 	EXPECT_EQ(n.missed, 0) << "pairs within d0 not reported (seed " << seed << ")";
 	EXPECT_EQ(n.emptyWithin, 0) << "pairs within d0 reported without sub-contacts (seed " << seed << ")";
+	EXPECT_EQ(n.tooDeepWithPrevious, 0) << "sub-contacts deeper than the pair's overlap and the hysteresis allow, with "
+	                                     << "a previous entrance (seed " << seed << ")";
 }
