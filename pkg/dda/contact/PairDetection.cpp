@@ -481,12 +481,27 @@ int likelySeparatingFace(const Prepared& owner, const Vector3& direction) {
 
 struct EdgeAxis {
 	bool valid = false;
+	// Parallel within the angle tolerance, not exactly: the axis bounds the
+	// pair's penetration but is no entrance (its crossing has no stable
+	// position).
+	bool nearParallel = false;
 	double separation = 0;              // [m]
 	Vector3 normal = Vector3::UnitZ();  // unit, from A towards B
 };
 
+// Separation [m] of the two blocks along unit n (from A towards B): the
+// smallest projection of B's corners minus the largest of A's. A lower bound
+// of their distance (or minus their overlap along n) for any n.
+double projectedSeparation(const Prepared& a, const Prepared& b, const Vector3& n) {
+	double highA = -std::numeric_limits<double>::infinity(), lowB = std::numeric_limits<double>::infinity();
+	for (int v = 0; v < a.cornerCount(); ++v) highA = std::max(highA, n.dot(a.corner(v)));
+	for (int v = 0; v < b.cornerCount(); ++v) lowB = std::min(lowB, n.dot(b.corner(v)));
+	return lowB - highA;
+}
+
 // Edge axis of edge ea of A and eb of B when the two edges form a face of the
-// Minkowski difference and are not parallel.
+// Minkowski difference and are not exactly parallel (nearParallel when they
+// are within the angle tolerance).
 // `cba`: arcSide(a, ea, b, first face of eb), after the caller's check that
 // the two faces of eb are on opposite sides (arcsCross).
 EdgeAxis edgeAxis(const Prepared& a, int ea, const Prepared& b, int eb, double sinTolerance, int cba) {
@@ -498,7 +513,19 @@ EdgeAxis edgeAxis(const Prepared& a, int ea, const Prepared& b, int eb, double s
 	const Vector3& db = fd.direction;
 	const Vector3 cross = da.cross(db);
 	const double crossNorm = cross.norm();
-	if (parallelDirections(da, db, cross, crossNorm, ed.length, fd.length, sinTolerance)) return axis;
+	if (parallelDirections(da, db, cross, crossNorm, ed.length, fd.length, sinTolerance)) {
+		if (!(crossNorm > 0) || parallelDirections(da, db, cross, crossNorm, ed.length, fd.length, 0.0)) return axis;
+		// Within the angle tolerance, not exactly parallel. Its normal is
+		// ill-conditioned for tiny angles, so its separation is the blocks'
+		// full projection on it, valid for any direction.
+		Vector3 n = cross / crossNorm;
+		if (n.dot(a.edgeStart(ea) - a.centroid) < 0) n = -n;
+		axis.valid = true;
+		axis.nearParallel = true;
+		axis.separation = projectedSeparation(a, b, n);
+		axis.normal = n;
+		return axis;
+	}
 	const Vector3& a0 = a.edgeStart(ea);
 	const Vector3& a1 = a.edgeEnd(ea);
 	const Vector3& b0 = b.edgeStart(eb);
@@ -714,7 +741,8 @@ void ownEntranceContact(const Prepared& block, bool blockIsA, int q, const Prepa
 // vertex-face contact of the other block's corners) entered by block `other`.
 // `depthBound` is the pair's separation (<= 0 when they overlap) as step 3
 // of detectPairContacts takes it: no sub-contact is deeper than the pair's
-// penetration allows (min(depthBound, 0), to the length tolerance). It is
+// penetration allows (min(depthBound, 0), to the length tolerance; for edge
+// crossings min(crossingBound, 0), crossingBound >= depthBound). It is
 // f's own separation, the lowest corner's distance from f's plane, only when
 // f bounds the pair's penetration (f is the best axis, or kept by
 // hysteresis); for the face search of an edge entrance, and for the face an
@@ -723,7 +751,7 @@ void ownEntranceContact(const Prepared& block, bool blockIsA, int q, const Prepa
 // corners and edge crossings that deep below f are no contact of theirs (they
 // gave sub-contacts 1 m deep between logs that did not touch).
 void faceEntranceContacts(const Prepared& owner, bool ownerIsA, int f, const Prepared& other, double depthBound,
-                          const DetectionSettings& settings, double sinTolerance, Scratch& s,
+                          double crossingBound, const DetectionSettings& settings, double sinTolerance, Scratch& s,
                           std::vector<SubContact>& out) {
 	// Within d0, to the length tolerance: a face is planar only to within it, so
 	// a corner touching a face may lie that far off the face's triangle plane.
@@ -778,8 +806,9 @@ void faceEntranceContacts(const Prepared& owner, bool ownerIsA, int f, const Pre
 	}
 
 	// Edges of the other block crossing the face's edges, no deeper than the
-	// pair's penetration allows (the rule at the top of this file).
-	const double deepest = std::min(depthBound, 0.0) - settings.lengthTolerance;
+	// pair's penetration allows (the rule at the top of this file; for
+	// crossings `crossingBound`, which near-parallel edge axes may raise).
+	const double deepest = std::min(crossingBound, 0.0) - settings.lengthTolerance;
 	std::vector<int>& faceEdges = s.faceEdges;
 	faceEdges.clear();
 	for (int e : owner.edgeList) {
@@ -819,16 +848,18 @@ void faceEntranceContacts(const Prepared& owner, bool ownerIsA, int f, const Pre
 // step. What the face finds at the crossing itself (the same edge pair, or a
 // corner or crossing within the corner merge distance of it) is the crossing's
 // contact and is left out. `depthBound` is the edge axis's separation (the
-// pair's).
+// pair's), `crossingBound` as for faceEntranceContacts.
 void otherFeaturesOfEdgeEntrance(const Prepared& a, const Prepared& b, const FaceCandidate& face, double depthBound,
-                                 const DetectionSettings& settings, double sinTolerance, Scratch& s,
-                                 std::vector<SubContact>& out) {
+                                 double crossingBound, const DetectionSettings& settings, double sinTolerance,
+                                 Scratch& s, std::vector<SubContact>& out) {
 	const SubContact crossing = out.front();
 	const std::size_t first = out.size();
 	if (face.feature.kind == EntranceFeature::FaceOfA)
-		faceEntranceContacts(a, true, face.feature.feature, b, depthBound, settings, sinTolerance, s, out);
+		faceEntranceContacts(a, true, face.feature.feature, b, depthBound, crossingBound, settings, sinTolerance, s,
+		                     out);
 	else
-		faceEntranceContacts(b, false, face.feature.feature, a, depthBound, settings, sinTolerance, s, out);
+		faceEntranceContacts(b, false, face.feature.feature, a, depthBound, crossingBound, settings, sinTolerance, s,
+		                     out);
 	const double merge = std::max(settings.cornerMergeDistance, settings.lengthTolerance);
 	const auto sameAsCrossing = [&](const SubContact& c) {
 		if (c.kind == ContactKind::EdgeEdge) {
@@ -1122,6 +1153,10 @@ bool detectPairContacts(const BlockGeometry& blockA, const BlockGeometry& blockB
 	prepareEdges(b, s, 1);
 	EdgeAxis bestEdge, previousEdge;
 	int bestEdgeA = -1, bestEdgeB = -1;
+	// Largest separation along the axes of edge pairs parallel within the
+	// angle tolerance (not exactly): no entrance and no rejection, as before,
+	// but a bound of the pair's penetration (step 3).
+	double nearParallelBest = -std::numeric_limits<double>::infinity();
 	// The faces of B at its edges (their planes are built: prepareEdges).
 	std::vector<int>& bFaces = s.edgeFacesB;
 	std::vector<int>& side = s.arcSides;
@@ -1150,6 +1185,10 @@ bool detectPairContacts(const BlockGeometry& blockA, const BlockGeometry& blockB
 			if (!(side[fb[0]] * side[fb[1]] < 0)) continue;
 			const EdgeAxis axis = edgeAxis(a, ea, b, eb, sinTolerance, side[fb[0]]);
 			if (!axis.valid) continue;
+			if (axis.nearParallel) {
+				nearParallelBest = std::max(nearParallelBest, axis.separation);
+				continue;
+			}
 			if (axis.separation > d0) return false;
 			deepestBound = std::max(deepestBound, axis.separation);
 			if (previous.kind == EntranceFeature::EdgePair && previous.feature == ea && previous.other == eb)
@@ -1219,22 +1258,37 @@ bool detectPairContacts(const BlockGeometry& blockA, const BlockGeometry& blockB
 	// deep between blocks 5.65 and 6.5 mm apart, ghost_pairs.json;
 	// `GhostPairsOfTheDepositHaveNoNegativeGap`), 13 of the oracle's 100,000
 	// random near pairs, and 257 of 16,613 calls with a previous entrance.
+	// An edge pair parallel within the angle tolerance is no entrance, but
+	// its axis bounds the penetration as well: when it separates the blocks
+	// more than the entrance, it bounds the edge crossings (a box lying along
+	// a slender block, edge along edge 0.01 rad apart: the entrance crossing of
+	// two other edges was 6.12 mm deep where the blocks overlapped by 5.84 mm;
+	// 1 of 2 million random near pairs of the oracle). Not the corners: the
+	// contact of two such edges is the vertex contacts at their ends, measured
+	// along the entrance face's normal, which lie deeper than the overlap
+	// across the edges (a bar resting edge on edge 1e-4 rad from parallel
+	// sank 0.13 mm into the other, tests/py/test_hard_cases.py, when its
+	// corners were bound by it).
 	const double depthBound = separation;
+	const double crossingBound = std::max(separation, nearParallelBest);
 	std::optional<std::array<int, 2>> fallbackEdges;  // the edge entrance's edges, when it falls back
 	out.normal = Vector3::UnitZ();  // the default, kept when no entrance sets it
 	out.contacts.clear();
 	if (entrance.kind == EntranceFeature::EdgePair) {
+		EdgeContactLimits limits;  // the crossing, too, no deeper than the bound
+		limits.deepestGap = std::min(crossingBound, 0.0) - tol;
 		std::optional<SubContact> c =
-		    edgeEdgeContact(true, a, entrance.feature, b, entrance.other, settings, sinTolerance);
+		    edgeEdgeContact(true, a, entrance.feature, b, entrance.other, settings, sinTolerance, limits);
 		if (c) {
 			out.normal = (previousEdge.valid && entrance == previous) ? previousEdge.normal : bestEdge.normal;
 			out.contacts.push_back(*c);
-			otherFeaturesOfEdgeEntrance(a, b, chooseFace(faces, a, b, tol, previous), depthBound, settings,
-			                            sinTolerance, s, out.contacts);
+			otherFeaturesOfEdgeEntrance(a, b, chooseFace(faces, a, b, tol, previous), depthBound, crossingBound,
+			                            settings, sinTolerance, s, out.contacts);
 		} else {
-			// The edges do not cross strictly inside (a corner meets an edge):
-			// the best face is the entrance, its separation the pair's
-			// reported one, but the depth bound stays the edge axis's.
+			// The edges do not cross strictly inside (a corner meets an edge),
+			// or their crossing is deeper than the bound: the best face is the
+			// entrance, its separation the pair's reported one, but the depth
+			// bound stays the edge axis's.
 			fallbackEdges = {entrance.feature, entrance.other};
 			const FaceCandidate& f = chooseFace(faces, a, b, tol, previous);
 			entrance = f.feature;
@@ -1243,12 +1297,37 @@ bool detectPairContacts(const BlockGeometry& blockA, const BlockGeometry& blockB
 	}
 	if (entrance.kind == EntranceFeature::FaceOfA) {
 		out.normal = a.faces[entrance.feature].normal;
-		faceEntranceContacts(a, true, entrance.feature, b, depthBound, settings, sinTolerance, s, out.contacts);
+		faceEntranceContacts(a, true, entrance.feature, b, depthBound, crossingBound, settings, sinTolerance, s,
+		                     out.contacts);
 	} else if (entrance.kind == EntranceFeature::FaceOfB) {
 		out.normal = -b.faces[entrance.feature].normal;
-		faceEntranceContacts(b, false, entrance.feature, a, depthBound, settings, sinTolerance, s, out.contacts);
+		faceEntranceContacts(b, false, entrance.feature, a, depthBound, crossingBound, settings, sinTolerance, s,
+		                     out.contacts);
 	}
 	if (fallbackEdges) cornersOfEdgeEntrance(a, (*fallbackEdges)[0], b, (*fallbackEdges)[1], settings, out.contacts);
+	// A face entrance that found nothing, among faces tied with the best
+	// (within lengthTolerance): the next tied face that finds something is the
+	// entrance. Two halves of a nearly planar side tie, and the one of larger
+	// area may not be the one the other block's corners lie over: a pair 9.2
+	// mm apart and one overlapping by 0.38 mm had no sub-contact at all (2 of
+	// 2 million random near pairs of the oracle).
+	if (out.contacts.empty() && entrance.kind != EntranceFeature::EdgePair) {
+		for (const FaceCandidate& c : faces) {
+			if (c.separation < bestFace - tol || c.feature == entrance) continue;
+			if (c.feature.kind == EntranceFeature::FaceOfA)
+				faceEntranceContacts(a, true, c.feature.feature, b, depthBound, crossingBound, settings, sinTolerance,
+				                     s, out.contacts);
+			else
+				faceEntranceContacts(b, false, c.feature.feature, a, depthBound, crossingBound, settings, sinTolerance,
+				                     s, out.contacts);
+			if (out.contacts.empty()) continue;
+			entrance = c.feature;
+			separation = c.separation;
+			out.normal = entrance.kind == EntranceFeature::FaceOfA ? a.faces[entrance.feature].normal
+			                                                        : Vector3(-b.faces[entrance.feature].normal);
+			break;
+		}
+	}
 	out.entrance = entrance;
 	out.separation = separation;
 
