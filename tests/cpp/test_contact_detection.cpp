@@ -1091,6 +1091,82 @@ TEST(ContactDetection, GhostPairsOfTheDepositHaveNoNegativeGap) {
 	}
 }
 
+// Three pairs the narrow-phase oracle found in its 2,000,000-pair run (seed
+// 20250917, pairs 415996, 666220 and 1160967 of
+// tests/cpp/test_narrow_phase_oracle.cpp), with World's settings for d0 = 1 cm:
+// a pair 9.19 mm apart whose entrance face ties with the face the corners lie over (no sub-contact before); a pair overlapping by 0.38 mm, same tie (no sub-contact before); a box along a slender block, edges 0.0103 rad from parallel (the entrance crossing was 6.12 mm deep for a 5.84 mm overlap). Each must keep a sub-contact, and none may be deeper than the
+// pair's overlap (its separating-axis value, every face normal and edge
+// cross product).
+TEST(ContactDetection, OracleFoundPairsKeepASubContactNoDeeperThanTheOverlap) {
+	const std::vector<std::vector<Vector3>> blocks = {
+	    {{-99.847840057879836, 41.443940016756862, -41.91048947971931},
+	     {-99.831771189353177, 41.523906657719394, -41.919394900181587},
+	     {-99.795115708008268, 41.439759629898063, -41.852892069985487},
+	     {-99.779046839481609, 41.519726270860595, -41.861797490447763},
+	     {-99.830242405759648, 41.438566487082845, -41.926988280698886},
+	     {-99.814173537232989, 41.518533128045377, -41.935893701161163},
+	     {-99.777518055888081, 41.434386100224046, -41.869390870965063},
+	     {-99.761449187361421, 41.514352741186578, -41.87829629142734}},
+	    {{-85.888679543471298, 33.12750400082713, -53.599682137520546},
+	     {-114.20474777128125, 50.535898700973874, -29.253635695324519},
+	     {-86.770029545456467, 33.791299213838258, -53.055005520763935},
+	     {-110.32547039781298, 48.277884546609691, -32.83872701513269},
+	     {-87.257516445325805, 33.822105449507809, -52.566164185117572},
+	     {-108.2411815006823, 46.676652596748923, -34.504777974304325},
+	     {-90.904860224626702, 36.160378966658712, -49.589838231027699},
+	     {-107.86171629383986, 46.61150601069648, -35.093945446874763}},
+	    {{76.591050245511553, 26.621079524843438, 44.796742740559644},
+	     {76.585909060334671, 26.634853185523706, 44.689532662758403},
+	     {76.770807559545645, 26.523204178072625, 44.765721476472478},
+	     {76.395660564164601, 26.260762544791419, 44.760492376908296},
+	     {76.390519378987719, 26.274536205471687, 44.653282299107062},
+	     {76.575417878198706, 26.162887198020609, 44.729471112821138}},
+	    {{75.738897075660702, 25.942977753370453, 44.666543751509103},
+	     {76.40231459568966, 27.320855242782443, 44.951710536403624},
+	     {76.531797519824678, 25.651749369506899, 45.043217572978868},
+	     {77.215474055530208, 26.772179726746444, 45.32366372221172},
+	     {75.873853238021752, 25.844255448883416, 44.560313156280799},
+	     {76.348478232892631, 27.14720210472727, 44.669285108255075},
+	     {76.938397405405624, 25.596083914883426, 45.054264533437909},
+	     {77.472424521971135, 27.016556680323617, 45.180459308490967}},
+	    {{98.384171329590927, 30.150233387868678, -25.778551816348866},
+	     {97.984805424801564, 30.052078510439856, -25.836736598975818},
+	     {98.369622314687263, 30.084608008282252, -25.567984189605752},
+	     {97.9702564098979, 29.98645313085343, -25.626168972232705},
+	     {98.362407560572393, 30.225728271557774, -25.756526877991284},
+	     {97.96304165578303, 30.127573394128952, -25.814711660618237},
+	     {98.347858545668728, 30.160102891971349, -25.545959251248171},
+	     {97.948492640879365, 30.061948014542526, -25.604144033875123}},
+	    {{88.100041458467743, 27.671570465781954, -27.357063969510484},
+	     {109.27233788876202, 32.930072000731734, -24.048117888236956},
+	     {86.141346180516663, 27.326561833936594, -27.721487051181857},
+	     {111.52921688894199, 33.6316771140322, -23.742899276505465},
+	     {85.625954929554908, 27.086493924345369, -27.724639998110554},
+	     {110.05361378914016, 33.146331386196515, -23.900349101050324},
+	     {85.067418224188103, 27.096830253843805, -27.877923732185319},
+	     {107.14640544351877, 32.561908363236213, -24.404611777152578}}};
+	for (int p = 0; p < 3; ++p) {
+		SCOPED_TRACE("pair " + std::to_string(p));
+		const double overlap =
+		    std::min(bruteForceSeparation(makeBlock(blocks[2 * p]), makeBlock(blocks[2 * p + 1])), 0.0);
+		const dda::Block a = dda::makeBlock(blocks[2 * p], dda::Material{}, false);
+		const dda::Block b = dda::makeBlock(blocks[2 * p + 1], dda::Material{}, false);
+		const DetectionSettings settings =
+		    dda::pairDetectionSettings(dda::boundingDiagonal(a), dda::boundingDiagonal(b), 0.01, 0.004);
+		for (const bool swap : {false, true}) {
+			const dda::BlockGeometry ga{a.shape.get(), &a.vertices, a.centroid};
+			const dda::BlockGeometry gb{b.shape.get(), &b.vertices, b.centroid};
+			const auto result =
+			    swap ? dda::detectPairContacts(gb, ga, settings) : dda::detectPairContacts(ga, gb, settings);
+			ASSERT_TRUE(result.has_value()) << "a pair within d0 not reported";
+			EXPECT_FALSE(result->contacts.empty()) << "a pair within d0 without sub-contacts";
+			for (const SubContact& c : result->contacts)
+				EXPECT_GE(c.gap, overlap - 2 * settings.lengthTolerance)
+				    << "a sub-contact " << c.gap << " m deep where the blocks overlap by " << -overlap << " m";
+		}
+	}
+}
+
 // A cube tilted 0.004 rad and turned 0.3 rad over a fixed unit cube, its
 // lowest corner overhanging the fixed cube's edge x = 1 so that the pair's
 // closest features are two edges crossing (an edge entrance). Its far
