@@ -56,7 +56,13 @@
 //          way, stays).
 //      No sub-contact is deeper than the pair's penetration: its gap is at
 //      least min(s, 0) - lengthTolerance, s the entrance axis's separation
-//      (the pair's best axis, or the previous entrance kept by hysteresis).
+//      (the pair's best axis, or the previous entrance kept by hysteresis);
+//      an edge crossing's also no deeper than the axes of edge pairs parallel
+//      within the angle tolerance allow (they are no entrance, and their
+//      contact is the vertex contacts at their ends, measured along the
+//      entrance face). A face entrance that finds no sub-contact gives way
+//      to the next face tied with the best (within lengthTolerance) that
+//      finds some.
 //      A translation of the penetration depth separates the blocks and moves
 //      any gap by at most that depth, so a deeper gap is no contact.
 //      An edge entrance gives its edge-edge sub-contact (block i = A), or
