@@ -61,7 +61,10 @@
 // Before the depth bound of PairDetection.cpp (core d410179), seed 20250917:
 // 1,401 of 100,000 pairs failed property 1 (13 with negative gaps between
 // blocks apart, 1,388 with edge crossings 1 to 2 x the penetration deep) and
-// 257 of 16,613 calls property 3; none since.
+// 257 of 16,613 calls property 3. The 2,000,000-pair run then found 3 more
+// (two pairs within d0 without a sub-contact, one crossing deeper than the
+// overlap: ContactDetection.OracleFoundPairsKeepASubContactNoDeeperThanTheOverlap);
+// none since (2,000,000 pairs in 476 s).
 //
 // Environment: DDA_ORACLE_PAIRS (default 100,000, about 20 s on the 2-core
 // development machine; `make test-hard` runs 2,000,000), DDA_ORACLE_SEED
