@@ -44,6 +44,12 @@
 //      contact, a ghost. For a pair apart (S > 0): no negative gap. (A gap
 //      between 0 and S is a corner's distance from a face's plane just past
 //      the face's edge, a vertex-edge contact entered through the face.)
+//      For vertex-face sub-contacts S leaves out the edge pairs parallel
+//      within the settings' angle tolerance: the narrow phase treats those
+//      as parallel, and represents their contact by the vertex contacts at
+//      their ends, measured along the entrance face's normal, which can lie
+//      deeper than the overlap across the two edges (1 vertex-face contact 5
+//      um below S in a 2,000,000-pair run, seed 1; counted and printed).
 //      Tolerance: 2 x lengthTolerance (the narrow phase measures corners
 //      against one triangle of a face planar to 1e-9 of the diagonal, and
 //      takes faces within lengthTolerance of the best as ties) plus
@@ -208,6 +214,7 @@ struct Oracle {
 	using LVector = Eigen::Matrix<Real, 3, 1>;
 	std::vector<LVector> a, b;  // corners
 	std::vector<LVector> axes;  // translation-invariant directions (S)
+	std::vector<char> nearParallel;  // per axis: an edge pair parallel within the angle tolerance
 
 	static LVector toLong(const Vector3& x) { return LVector(x.x(), x.y(), x.z()); }
 	static bool normalize(LVector& v) {
@@ -234,10 +241,13 @@ struct Oracle {
 		return std::max(lowB - highA, lowA - highB);
 	}
 
-	void build(const Placed& A, const Placed& B) {
+	// `sinAngleTolerance`: edge pairs with |da x db| <= it x |da| |db| (to a
+	// relative 1e-6, on the permissive side) are marked nearParallel.
+	void build(const Placed& A, const Placed& B, Real sinAngleTolerance = 0) {
 		a.clear();
 		b.clear();
 		axes.clear();
+		nearParallel.clear();
 		for (const Vector3& x : A.vertices) a.push_back(toLong(x));
 		for (const Vector3& x : B.vertices) b.push_back(toLong(x));
 		for (const auto* block : {&A, &B}) {
@@ -248,21 +258,30 @@ struct Oracle {
 					for (int j = i + 1; j < n; ++j)
 						for (int k = j + 1; k < n; ++k) {
 							LVector m = (corners[face[j]] - corners[face[i]]).cross(corners[face[k]] - corners[face[i]]);
-							if (normalize(m)) axes.push_back(m);
+							if (normalize(m)) {
+								axes.push_back(m);
+								nearParallel.push_back(0);
+							}
 						}
 			}
 		}
 		for (const auto& ea : A.shape->polyhedron.edges)
 			for (const auto& eb : B.shape->polyhedron.edges) {
-				LVector m = (a[ea[1]] - a[ea[0]]).cross(b[eb[1]] - b[eb[0]]);
-				if (normalize(m)) axes.push_back(m);
+				const LVector da = a[ea[1]] - a[ea[0]], db = b[eb[1]] - b[eb[0]];
+				LVector m = da.cross(db);
+				const bool near = m.norm() <= sinAngleTolerance * (1 + 1e-6) * da.norm() * db.norm();
+				if (!normalize(m)) continue;
+				axes.push_back(m);
+				nearParallel.push_back(near);
 			}
 	}
 
-	// S: the separating-axis value [m].
-	Real separatingAxisValue() const {
+	// S: the separating-axis value [m]; without the near-parallel edge axes
+	// when `nearParallelToo` is false.
+	Real separatingAxisValue(bool nearParallelToo = true) const {
 		Real s = -std::numeric_limits<Real>::infinity();
-		for (const LVector& m : axes) s = std::max(s, bestSeparation(m));
+		for (std::size_t k = 0; k < axes.size(); ++k)
+			if (nearParallelToo || !nearParallel[k]) s = std::max(s, bestSeparation(axes[k]));
 		return s;
 	}
 
@@ -332,6 +351,7 @@ struct Counts {
 	long withinContactDistance = 0, reported = 0, reportedBeyond = 0, subContacts = 0;  // beyond: S > d0
 	long tooDeep = 0, negativeApart = 0, missed = 0, emptyWithin = 0;
 	long withPrevious = 0, tooDeepWithPrevious = 0;  // the calls with a previous entrance
+	long cornersBelowNearParallel = 0;  // vertex-face sub-contacts below min(S, 0) - tolerance (allowed, header)
 	double worstExcess = 0;  // deepest (S - tolerance) - gap over the pairs [m]
 };
 
@@ -393,10 +413,6 @@ TEST(NarrowPhaseOracle, RandomNearPairsAgainstExactSeparationAndDistance) {
 			continue;
 		}
 		const Placed B = place(*shapeB, rotationB, inside - rotationB * shapeB->centroid + *t * u);
-		oracle.build(A, B);
-		const long double s = oracle.separatingAxisValue();
-		(s < 0 ? n.overlapping : n.apart)++;
-
 		// World's settings for the pair, d0 = 2.5 x the allowed displacement.
 		const auto diagonal = [](const Placed& p) {
 			Eigen::AlignedBox3d box;
@@ -405,6 +421,12 @@ TEST(NarrowPhaseOracle, RandomNearPairsAgainstExactSeparationAndDistance) {
 		};
 		const dda::DetectionSettings settings =
 		    dda::pairDetectionSettings(diagonal(A), diagonal(B), kContactDistance, kContactDistance / 2.5);
+		oracle.build(A, B, std::sin(static_cast<long double>(settings.angleTolerance)));
+		const long double s = oracle.separatingAxisValue();
+		// For corners: without edge pairs parallel within the angle tolerance
+		// (property 1, header).
+		const long double sCorners = oracle.separatingAxisValue(false);
+		(s < 0 ? n.overlapping : n.apart)++;
 		const double tolerance = 2 * settings.lengthTolerance + kOracleRoundoff;
 		// D only where it decides "within d0" (D >= S; D = 0 when S < 0).
 		const long double d = s < 0 ? 0.0L
@@ -443,7 +465,11 @@ TEST(NarrowPhaseOracle, RandomNearPairsAgainstExactSeparationAndDistance) {
 		std::ostringstream what;
 		what.precision(6);
 		for (const dda::SubContact& c : result->contacts) {
-			const double excess = std::min(static_cast<double>(s), 0.0) - tolerance - c.gap;
+			const bool corner = c.kind == dda::ContactKind::VertexFace;
+			if (corner && c.gap < std::min(static_cast<double>(s), 0.0) - tolerance &&
+			    c.gap >= std::min(static_cast<double>(sCorners), 0.0) - tolerance)
+				++n.cornersBelowNearParallel;
+			const double excess = std::min(static_cast<double>(corner ? sCorners : s), 0.0) - tolerance - c.gap;
 			if (excess > 0) {
 				deep = true;
 				if (s > 0 && c.gap < -tolerance) negative = true;
@@ -480,8 +506,9 @@ TEST(NarrowPhaseOracle, RandomNearPairsAgainstExactSeparationAndDistance) {
 			    swap ? dda::detectPairContacts(geometryB, geometryA, settings, previous)
 			         : dda::detectPairContacts(geometryA, geometryB, settings, previous);
 			if (!kept) continue;
-			const double bound = std::min(static_cast<double>(s) - settings.hysteresis, 0.0) - tolerance;
 			for (const dda::SubContact& c : kept->contacts) {
+				const long double axisValue = c.kind == dda::ContactKind::VertexFace ? sCorners : s;
+				const double bound = std::min(static_cast<double>(axisValue) - settings.hysteresis, 0.0) - tolerance;
 				if (c.gap >= bound) continue;
 				++n.tooDeepWithPrevious;
 				report(index, A, B, s, d,
@@ -498,11 +525,12 @@ TEST(NarrowPhaseOracle, RandomNearPairsAgainstExactSeparationAndDistance) {
 	    "apart; %ld within d0, %ld reported (%ld beyond d0), %ld sub-contacts\n"
 	    "  failures: %ld too deep (%ld of them negative between blocks apart), %ld missed within d0, %ld within d0 "
 	    "without sub-contacts; worst excess %.3g m; with a previous entrance (%ld calls): %ld too deep; %.1f s (%.1f "
-	    "us per pair)\n",
+	    "us per pair)\n  vertex-face sub-contacts deeper than S only through a near-parallel edge axis (allowed): "
+	    "%ld\n",
 	    seed, n.pairs, n.unbuilt, n.unplaced, n.overlapping, n.apart, n.withinContactDistance, n.reported,
 	    n.reportedBeyond, n.subContacts, n.tooDeep, n.negativeApart, n.missed, n.emptyWithin, n.worstExcess,
-	    n.withPrevious, n.tooDeepWithPrevious, seconds,
-	    1e6 * seconds / std::max<long>(n.pairs, 1));
+	    n.withPrevious, n.tooDeepWithPrevious, seconds, 1e6 * seconds / std::max<long>(n.pairs, 1),
+	    n.cornersBelowNearParallel);
 	std::fflush(stdout);
 	// The sampling must reach both classes and the contact band.
 	if (pairs >= 1000) {
