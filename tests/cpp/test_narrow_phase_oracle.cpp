@@ -72,8 +72,9 @@
 // overlap: ContactDetection.OracleFoundPairsKeepASubContactNoDeeperThanTheOverlap);
 // none since (2,000,000 pairs in 476 s).
 //
-// Environment: DDA_ORACLE_PAIRS (default 100,000, about 20 s on the 2-core
-// development machine; `make test-hard` runs 2,000,000), DDA_ORACLE_SEED
+// Environment: DDA_ORACLE_PAIRS (default 100,000: about 20 s alone on the
+// 2-core development machine, 26 to 35 s beside the other tests of ctest -j 2;
+// `make test-hard` runs 2,000,000, 8 to 10 min), DDA_ORACLE_SEED
 // (default 20250917), DDA_ORACLE_PRINT (failures described in full, default
 // 10). Each pair draws from its own generator seeded by (seed, index), so
 // DDA_ORACLE_FIRST=k DDA_ORACLE_PAIRS=1 replays pair k alone. The seed, the
