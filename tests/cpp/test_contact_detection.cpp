@@ -1027,6 +1027,146 @@ TEST(ContactDetection, EdgeCrossingsOfBlocksApartAreNeverDeep) {
 	}
 }
 
+// Two pairs of the 50,000-block slender deposit (bodies 22145/22146, a
+// hexahedron and a triangular prism 5.65 mm apart; 44194/45600, 6.5 mm apart:
+// /work/shared/repro/ghost_pairs.json, corners in m), with World's settings
+// for d0 = 1 cm. Their best axis is an edge pair whose edges do not cross
+// strictly inside, so the entrance falls back to the best face, which lies
+// 0.16 and 0.11 m deep; its separation was taken as the depth bound, and the
+// pairs got an edge-edge sub-contact 0.25 m deep (closed, locked, 5.1e7 N)
+// and a vertex-face one 2.6 mm deep. Every sub-contact of a pair apart must
+// have a positive gap, and the pairs, within d0, must keep a contact: the
+// ends of the fallback's edges against their own entrance faces.
+TEST(ContactDetection, GhostPairsOfTheDepositHaveNoNegativeGap) {
+	const std::vector<std::vector<Vector3>> blocks = {
+	    {{18.925986157, 6.450697633, 17.003494633},
+	     {18.838917728, 6.428241197, 16.752056349},
+	     {19.381541205, 5.968348375, 16.832063324},
+	     {19.294472776, 5.945891939, 16.580625039},
+	     {19.746758846, 7.13273078, 16.497382015},
+	     {19.659690417, 7.110274345, 16.24594373},
+	     {20.202313894, 6.650381522, 16.325950706},
+	     {20.115245465, 6.627925087, 16.074512421}},
+	    {{20.220258301, 5.706508503, 16.327361119},
+	     {19.750287835, 6.132223302, 16.25940593},
+	     {20.014291509, 5.858464939, 16.561993541},
+	     {21.309794737, 6.934980369, 16.488183383},
+	     {20.839824271, 7.360695168, 16.420228194},
+	     {21.103827946, 7.086936805, 16.722815806}},
+	    {{15.876995769, 10.467384398, 32.625686741},
+	     {15.96078133, 10.325168142, 32.677523562},
+	     {16.503924233, 10.974056481, 33.193784437},
+	     {16.587709793, 10.831840226, 33.245621259},
+	     {16.49784601, 10.219282278, 31.773819417},
+	     {16.58163157, 10.077066022, 31.825656238},
+	     {17.124774473, 10.725954362, 32.341917114},
+	     {17.208560033, 10.583738106, 32.393753935}},
+	    {{17.171292881, 11.473600174, 33.859889617},
+	     {16.97806806, 10.728634305, 33.407046159},
+	     {16.987206688, 11.21649584, 33.964439189},
+	     {15.984836048, 12.105948105, 33.325875682},
+	     {15.791611227, 11.360982237, 32.873032224},
+	     {15.800749855, 11.848843772, 33.430425254}}};
+	const std::vector<double> apart = {5.6e-3, 6.4e-3};  // below their separating axes' 5.65 and 6.5 mm [m]
+	for (int p = 0; p < 2; ++p) {
+		SCOPED_TRACE("pair " + std::to_string(p));
+		ASSERT_GT(bruteForceSeparation(makeBlock(blocks[2 * p]), makeBlock(blocks[2 * p + 1])), apart[p]);
+		const dda::Block a = dda::makeBlock(blocks[2 * p], dda::Material{}, false);
+		const dda::Block b = dda::makeBlock(blocks[2 * p + 1], dda::Material{}, false);
+		for (const double allowed : {0.0, 0.004}) {  // before the first step, and the deposit's
+			const DetectionSettings settings =
+			    dda::pairDetectionSettings(dda::boundingDiagonal(a), dda::boundingDiagonal(b), 0.01, allowed);
+			for (const bool swap : {false, true}) {
+				const dda::BlockGeometry ga{a.shape.get(), &a.vertices, a.centroid};
+				const dda::BlockGeometry gb{b.shape.get(), &b.vertices, b.centroid};
+				const auto result =
+				    swap ? dda::detectPairContacts(gb, ga, settings) : dda::detectPairContacts(ga, gb, settings);
+				ASSERT_TRUE(result.has_value()) << "a pair within d0 not reported";
+				EXPECT_FALSE(result->contacts.empty()) << "a pair within d0 without sub-contacts";
+				for (const SubContact& c : result->contacts)
+					EXPECT_GE(c.gap, -settings.lengthTolerance)
+					    << "a sub-contact " << c.gap << " m deep between blocks apart";
+			}
+		}
+	}
+}
+
+// Three pairs the narrow-phase oracle found in its 2,000,000-pair run (seed
+// 20250917, pairs 415996, 666220 and 1160967 of
+// tests/cpp/test_narrow_phase_oracle.cpp), with World's settings for d0 = 1 cm:
+// a pair 9.19 mm apart whose entrance face ties with the face the corners lie over (no sub-contact before); a pair overlapping by 0.38 mm, same tie (no sub-contact before); a box along a slender block, edges 0.0103 rad from parallel (the entrance crossing was 6.12 mm deep for a 5.84 mm overlap). Each must keep a sub-contact, and none may be deeper than the
+// pair's overlap (its separating-axis value, every face normal and edge
+// cross product).
+TEST(ContactDetection, OracleFoundPairsKeepASubContactNoDeeperThanTheOverlap) {
+	const std::vector<std::vector<Vector3>> blocks = {
+	    {{-99.847840057879836, 41.443940016756862, -41.91048947971931},
+	     {-99.831771189353177, 41.523906657719394, -41.919394900181587},
+	     {-99.795115708008268, 41.439759629898063, -41.852892069985487},
+	     {-99.779046839481609, 41.519726270860595, -41.861797490447763},
+	     {-99.830242405759648, 41.438566487082845, -41.926988280698886},
+	     {-99.814173537232989, 41.518533128045377, -41.935893701161163},
+	     {-99.777518055888081, 41.434386100224046, -41.869390870965063},
+	     {-99.761449187361421, 41.514352741186578, -41.87829629142734}},
+	    {{-85.888679543471298, 33.12750400082713, -53.599682137520546},
+	     {-114.20474777128125, 50.535898700973874, -29.253635695324519},
+	     {-86.770029545456467, 33.791299213838258, -53.055005520763935},
+	     {-110.32547039781298, 48.277884546609691, -32.83872701513269},
+	     {-87.257516445325805, 33.822105449507809, -52.566164185117572},
+	     {-108.2411815006823, 46.676652596748923, -34.504777974304325},
+	     {-90.904860224626702, 36.160378966658712, -49.589838231027699},
+	     {-107.86171629383986, 46.61150601069648, -35.093945446874763}},
+	    {{76.591050245511553, 26.621079524843438, 44.796742740559644},
+	     {76.585909060334671, 26.634853185523706, 44.689532662758403},
+	     {76.770807559545645, 26.523204178072625, 44.765721476472478},
+	     {76.395660564164601, 26.260762544791419, 44.760492376908296},
+	     {76.390519378987719, 26.274536205471687, 44.653282299107062},
+	     {76.575417878198706, 26.162887198020609, 44.729471112821138}},
+	    {{75.738897075660702, 25.942977753370453, 44.666543751509103},
+	     {76.40231459568966, 27.320855242782443, 44.951710536403624},
+	     {76.531797519824678, 25.651749369506899, 45.043217572978868},
+	     {77.215474055530208, 26.772179726746444, 45.32366372221172},
+	     {75.873853238021752, 25.844255448883416, 44.560313156280799},
+	     {76.348478232892631, 27.14720210472727, 44.669285108255075},
+	     {76.938397405405624, 25.596083914883426, 45.054264533437909},
+	     {77.472424521971135, 27.016556680323617, 45.180459308490967}},
+	    {{98.384171329590927, 30.150233387868678, -25.778551816348866},
+	     {97.984805424801564, 30.052078510439856, -25.836736598975818},
+	     {98.369622314687263, 30.084608008282252, -25.567984189605752},
+	     {97.9702564098979, 29.98645313085343, -25.626168972232705},
+	     {98.362407560572393, 30.225728271557774, -25.756526877991284},
+	     {97.96304165578303, 30.127573394128952, -25.814711660618237},
+	     {98.347858545668728, 30.160102891971349, -25.545959251248171},
+	     {97.948492640879365, 30.061948014542526, -25.604144033875123}},
+	    {{88.100041458467743, 27.671570465781954, -27.357063969510484},
+	     {109.27233788876202, 32.930072000731734, -24.048117888236956},
+	     {86.141346180516663, 27.326561833936594, -27.721487051181857},
+	     {111.52921688894199, 33.6316771140322, -23.742899276505465},
+	     {85.625954929554908, 27.086493924345369, -27.724639998110554},
+	     {110.05361378914016, 33.146331386196515, -23.900349101050324},
+	     {85.067418224188103, 27.096830253843805, -27.877923732185319},
+	     {107.14640544351877, 32.561908363236213, -24.404611777152578}}};
+	for (int p = 0; p < 3; ++p) {
+		SCOPED_TRACE("pair " + std::to_string(p));
+		const double overlap =
+		    std::min(bruteForceSeparation(makeBlock(blocks[2 * p]), makeBlock(blocks[2 * p + 1])), 0.0);
+		const dda::Block a = dda::makeBlock(blocks[2 * p], dda::Material{}, false);
+		const dda::Block b = dda::makeBlock(blocks[2 * p + 1], dda::Material{}, false);
+		const DetectionSettings settings =
+		    dda::pairDetectionSettings(dda::boundingDiagonal(a), dda::boundingDiagonal(b), 0.01, 0.004);
+		for (const bool swap : {false, true}) {
+			const dda::BlockGeometry ga{a.shape.get(), &a.vertices, a.centroid};
+			const dda::BlockGeometry gb{b.shape.get(), &b.vertices, b.centroid};
+			const auto result =
+			    swap ? dda::detectPairContacts(gb, ga, settings) : dda::detectPairContacts(ga, gb, settings);
+			ASSERT_TRUE(result.has_value()) << "a pair within d0 not reported";
+			EXPECT_FALSE(result->contacts.empty()) << "a pair within d0 without sub-contacts";
+			for (const SubContact& c : result->contacts)
+				EXPECT_GE(c.gap, overlap - 2 * settings.lengthTolerance)
+				    << "a sub-contact " << c.gap << " m deep where the blocks overlap by " << -overlap << " m";
+		}
+	}
+}
+
 // A cube tilted 0.004 rad and turned 0.3 rad over a fixed unit cube, its
 // lowest corner overhanging the fixed cube's edge x = 1 so that the pair's
 // closest features are two edges crossing (an edge entrance). Its far

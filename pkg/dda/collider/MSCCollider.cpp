@@ -17,7 +17,9 @@
 // their boxes, widened by d0 + w each, overlap whenever every coordinate of
 // P - q is at most 2 d0 + wA + wB: true for delta <= d0 / 2 (w covers the
 // length tolerance). An edge-edge contact's closest points are |gap| apart,
-// gap in [2 min(separation, 0) - reach, reach]: the same bound. So the union
+// gap in [min(separation, 0) - reach, reach]: the same bound. (The corner
+// contacts an edge entrance adds when its edges do not cross strictly inside
+// are vertex-face contacts as above.) So the union
 // over the overlapping shells links them. Deeper overlaps are not covered by
 // this argument (a corner far inside may pick a face beyond its shells).
 // The frame test uses nothing else: for any unit direction u, |(P - q) . u| <=

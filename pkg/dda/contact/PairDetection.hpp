@@ -45,18 +45,33 @@
 //          closest points more than lengthTolerance inside the segments (a
 //          crossing at an endpoint is a vertex contact), non-parallel, its
 //          gap within d0, its point on I's edge within d0 of F's plane, its
-//          normal within 60 degrees of n and its gap no deeper than
-//          2 x (the entrance's penetration) + d0: an edge piercing F steeply
+//          normal within 60 degrees of n and its gap no deeper than the
+//          pair's penetration (to lengthTolerance; an edge piercing F steeply
 //          near F's boundary has its line distance in F's plane and would
-//          push sideways by an unrelated depth; and not within
+//          push sideways by an unrelated depth); and not within
 //          cornerMergeDistance of a vertex-face contact above whose normal
 //          is within ~25 degrees of its own (offset squares cross each
 //          other's edges right beside a corner that already has its contact;
 //          a crossing next to a corner with no contact, or pushing another
 //          way, stays).
+//      No sub-contact is deeper than the pair's penetration: its gap is at
+//      least min(s, 0) - lengthTolerance, s the entrance axis's separation
+//      (the pair's best axis, or the previous entrance kept by hysteresis);
+//      an edge crossing's also no deeper than the axes of edge pairs parallel
+//      within the angle tolerance allow (they are no entrance, and their
+//      contact is the vertex contacts at their ends, measured along the
+//      entrance face). A face entrance that finds no sub-contact gives way
+//      to the next face tied with the best (within lengthTolerance) that
+//      finds some.
+//      A translation of the penetration depth separates the blocks and moves
+//      any gap by at most that depth, so a deeper gap is no contact.
 //      An edge entrance gives its edge-edge sub-contact (block i = A), or
 //      falls back to the best face when the two edges do not cross strictly
-//      inside. With the crossing, the best face (chosen as in step 2) adds
+//      inside; the depth bound then stays the edge axis's (the face's own
+//      separation may be a block's width deep), and each end of the two
+//      edges within d0 adds its vertex-face contact against its own entrance
+//      face (the closest features are then a corner and an edge, which the
+//      face alone may not see). With the crossing, the best face (chosen as in step 2) adds
 //      the sub-contacts it finds by the rules above away from the crossing:
 //      a block rocking on a crossing near one corner can have its far
 //      corner within d0 as well, and with the crossing alone that corner
