@@ -61,7 +61,6 @@ struct ContactHistory {
 	// strength) until tension or shear breaks it; a broken bond never heals.
 	bool bonded = false;
 	Vector3 shearForce = Vector3::Zero();  // force on block i in the tangent plane [N]
-	double energy = 0;  // energy of its springs at the end of the step [J] (World::accountStep)
 };
 
 struct Contact {

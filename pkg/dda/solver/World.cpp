@@ -9,8 +9,6 @@
 #include <chrono>
 #include <cmath>
 #include <ctime>
-#include <cstdio>
-#include <cstdlib>
 #include <sstream>
 
 namespace dda {
@@ -798,35 +796,13 @@ void World::accountStep(const IntegratorSettings& settings, double dt) {
 	// Contacts: their springs' energy at the start of this step in the
 	// accepted states against what the last step ended with.
 	double start = 0, end = 0;
-	for (Contact& contact : store_.contacts()) {
+	for (const Contact& contact : store_.contacts()) {
 		const int bi = contact.key.blockI, bj = contact.key.blockJ;
 		const ContactStepEnergy e = contactStepEnergy(contact, blocks_[bi], blocks_[bj], solutionOf(bi), solutionOf(bj));
-		if (std::getenv("DDA_DEBUG_JUMPS")) {
-			const double before = contact.isNew ? 0.0 : contact.history.energy;
-			if (std::abs(e.start - before) > 1.0)
-				std::fprintf(stderr, "jump step %ld contact %d-%d kind %d new %d state %d hist %d d0 %.3e start %.4e before %.4e type %d\n",
-				             steps_, bi, bj, int(contact.key.kind), int(contact.isNew), int(contact.trial.state),
-				             int(contact.history.state), contact.normal.d0, e.start, before, int(contact.pairType));
-		}
-		contact.trial.energy = e.end;
 		start += e.start;
 		end += e.end;
 		energy_.damping += e.damping;
 		energy_.friction += e.friction;
-		if (std::getenv("DDA_DEBUG_ENERGY")) {
-			Matrix24 K;
-			Vector24 f;
-			if (contactTerms(contact, blocks_[bi], blocks_[bj], K, f)) {
-				Vector24 D;
-				D << solutionOf(bi), solutionOf(bj);
-				double work = (f - K * D).dot(D);
-				const double predicted = -(e.end - e.start) - e.damping - e.friction;
-				if (std::abs(work - predicted) > 1.0)
-					std::fprintf(stderr, "step %ld contact %d-%d kind %d state %d bonded %d new %d d0 %.3e d1 %.3e work %.4e predicted %.4e\n",
-					             steps_, bi, bj, int(contact.key.kind), int(contact.trial.state), int(contact.trial.bonded),
-					             int(contact.isNew), contact.normal.d0, contactGap(contact, solutionOf(bi), solutionOf(bj)), work, predicted);
-			}
-		}
 	}
 	energy_.contactChanges += start - energy_.contact;
 	energy_.contact = end;
@@ -1012,17 +988,6 @@ double World::step(const IntegratorSettings& settings) {
 				++group_.passes[g];
 				++stats.limitPasses;
 				group_.passSolves[g] = 0;
-			}
-			if (std::getenv("DDA_DEBUG_ITER")) {
-				double worst = 0, limit = 0;
-				int passes = 0;
-				for (int g = 0; g < n; ++g) {
-					if (group_.largestNormalForce[g] > 0) worst = std::max(worst, group_.forceChange[g] / group_.largestNormalForce[g]);
-					if (group_.largestLimit[g] > 0) limit = std::max(limit, group_.limitChange[g] / group_.largestLimit[g]);
-					passes = std::max(passes, group_.passes[g]);
-				}
-				std::fprintf(stderr, "step %ld attempt %d it %d changes %d force %.2e limit %.2e passes %d\n", steps_, attempt,
-				             iterations, changes, worst, limit, passes);
 			}
 			if (allDone) {
 				converged = true;

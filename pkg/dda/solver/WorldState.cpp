@@ -138,7 +138,6 @@ void writeHistory(StateWriter& out, const ContactHistory& h) {
 	out.pod(h.normalForce);
 	out.pod(static_cast<std::uint8_t>(h.bonded));
 	out.matrix(h.shearForce);
-	out.pod(h.energy);
 }
 
 void readHistory(StateReader& in, ContactHistory& h) {
@@ -151,7 +150,6 @@ void readHistory(StateReader& in, ContactHistory& h) {
 	in.pod(h.normalForce);
 	h.bonded = in.pod<std::uint8_t>() != 0;
 	in.matrix(h.shearForce);
-	in.pod(h.energy);
 }
 
 ContactKind readKind(StateReader& in) {
