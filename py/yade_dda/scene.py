@@ -183,7 +183,19 @@ def stats():
     failed), ``openCloseCuts`` (dt cuts because the iteration did not
     converge), ``openCloseFailures`` (cumulative steps accepted unconverged),
     ``maxPenetration`` [m] (deepest closed contact), ``components`` and
-    ``largestComponent`` (independent systems solved, blocks in the largest).
+    ``largestComponent`` (independent systems solved, blocks in the largest),
+    ``lineSearches`` (solves whose step a line search shortened),
+    ``limitPasses`` and ``limitsUnsettled`` (friction-limit passes after the
+    first; groups of touching blocks accepted with limits still moving).
+    ``energy``: the energy account [J], each term from its own formula:
+    ``kinetic``, ``gravity`` (potential of the last step's gravity),
+    ``strain``, ``contact`` (springs of the closed contacts), and summed over
+    the steps ``friction`` and ``damping`` (dissipated) and ``loads`` (work of
+    point loads and fixed points); ``contactChanges`` is what the contacts'
+    springs gained between steps (new penetrating contacts, gaps linearised
+    again, springs lost on opening). kinetic + gravity + strain + contact +
+    friction + damping - loads - contactChanges is conserved (README,
+    *Diagnostics*).
     ``memory``: heap bytes held after the detection: ``collider`` (the broad
     phase's arrays: boxes, shells, grid, caches), ``contacts`` (the contact
     store with the previous step's contacts kept for their history) and
