@@ -26,29 +26,17 @@ import os
 import random
 import time
 
+import sys
+
 import yade_dda
 from yade_dda import O, ddaBlock, DDAIntegrator, block
 from yade import wrapper
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'tests', 'py'))
+from helpers import box, rotate  # noqa: E402  (the tests' shapes: same piles as test_energy_and_creep.py)
+
 G = 9.81
 SEED = 20261125
-
-
-def _box(lo, hi):
-    return [(x, y, z) for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])]
-
-
-def _turned(points, axis, angle, about):
-    n = math.sqrt(sum(a * a for a in axis))
-    k = [a / n for a in axis]
-    c, s = math.cos(angle), math.sin(angle)
-    out = []
-    for p in points:
-        v = [p[i] - about[i] for i in range(3)]
-        kxv = (k[1] * v[2] - k[2] * v[1], k[2] * v[0] - k[0] * v[2], k[0] * v[1] - k[1] * v[0])
-        kv = sum(k[i] * v[i] for i in range(3))
-        out.append(tuple(about[i] + v[i] * c + kxv[i] * s + k[i] * kv * (1 - c) for i in range(3)))
-    return out
 
 
 def run(young, duration, count=30):
@@ -56,13 +44,13 @@ def run(young, duration, count=30):
     rng = random.Random(SEED)
     rock = O.materials.append(wrapper.PolyhedraMat(density=2600, young=young, poisson=0.25,
                                                    frictionAngle=math.radians(30)))
-    O.bodies.append(ddaBlock(_box((-2, -2, -1), (6, 6, 0)), material=rock, fixed=True))
+    O.bodies.append(ddaBlock(box((-2, -2, -1), (6, 6, 0)), material=rock, fixed=True))
     cubes = []
     for k in range(count):
         i, j, layer = k % 3, (k // 3) % 3, k // 9
         x, y, z = 0.1 + 1.1 * i, 0.1 + 1.1 * j, 0.2 + 1.1 * layer
-        pts = _turned(_box((x, y, z), (x + 1, y + 1, z + 1)), (rng.random(), rng.random(), rng.random()),
-                      rng.uniform(-0.1, 0.1), (x + .5, y + .5, z + .5))
+        pts = rotate(box((x, y, z), (x + 1, y + 1, z + 1)), (rng.random(), rng.random(), rng.random()),
+                     rng.uniform(-0.1, 0.1), about=(x + .5, y + .5, z + .5))
         cubes.append(O.bodies.append(ddaBlock(pts, material=rock)))
     O.engines = [DDAIntegrator(gravity=(0, 0, -G), label='dda')]
 

@@ -52,6 +52,21 @@ double lockedEnergy(const Contact& c, const Block& bi, const Block& bj, const Ve
 	return 0.5 * c.normalStiffness * dn * dn + 0.5 * c.shearStiffness * shear.squaredNorm();
 }
 
+// Gradient and Hessian of `energy` at D = 0 by central differences with step h.
+template <class Energy>
+void finiteDifferences(const Energy& energy, double h, Vector24& gradient, Matrix24& hessian) {
+	for (int a = 0; a < 24; ++a) {
+		Vector24 e = Vector24::Zero();
+		e(a) = h;
+		gradient(a) = (energy(e) - energy(-e)) / (2 * h);
+		for (int b = 0; b < 24; ++b) {
+			Vector24 f = Vector24::Zero();
+			f(b) = h;
+			hessian(a, b) = (energy(e + f) - energy(e - f) - energy(-e + f) + energy(-e - f)) / (4 * h * h);
+		}
+	}
+}
+
 }  // namespace
 
 TEST(ContactMechanics, LockedTermsAreTheHessianAndGradientOfTheExactEnergy) {
@@ -74,24 +89,14 @@ TEST(ContactMechanics, LockedTermsAreTheHessianAndGradientOfTheExactEnergy) {
 	EXPECT_NEAR((K - K.transpose()).norm(), 0.0, 1e-9 * K.norm());
 
 	// Gradient: F = -dE/dD at D = 0; Hessian: K = d2E/dD2 at D = 0.
-	const double h = 1e-6;
 	Vector24 gradient;
 	Matrix24 hessian;
-	for (int a = 0; a < 24; ++a) {
-		Vector24 e = Vector24::Zero();
-		e(a) = h;
-		gradient(a) = (lockedEnergy(c, bi, bj, e) - lockedEnergy(c, bi, bj, -e)) / (2 * h);
-		for (int b = 0; b < 24; ++b) {
-			Vector24 f = Vector24::Zero();
-			f(b) = h;
-			hessian(a, b) = (lockedEnergy(c, bi, bj, e + f) - lockedEnergy(c, bi, bj, e - f) -
-			                 lockedEnergy(c, bi, bj, -e + f) + lockedEnergy(c, bi, bj, -e - f)) /
-			                (4 * h * h);
-		}
-	}
+	finiteDifferences([&](const Vector24& D) { return lockedEnergy(c, bi, bj, D); }, 1e-6, gradient, hessian);
 	EXPECT_LT((F + gradient).norm(), 1e-6 * gradient.norm());
 	EXPECT_LT((K - hessian).norm(), 1e-6 * hessian.norm());
 }
+
+namespace {
 
 // Energy of a closed contact with Coulomb's limit L on its tangential spring
 // (the Huber function psi of ContactEquations.hpp) for unknowns D: normal
@@ -107,6 +112,8 @@ double coulombEnergy(const Contact& c, const Block& bi, const Block& bj, const V
 	const double psi = ks * s <= limit ? 0.5 * ks * s * s : limit * s - limit * limit / (2 * ks);
 	return 0.5 * c.normalStiffness * dn * dn + psi;
 }
+
+}  // namespace
 
 TEST(ContactMechanics, SlipTermsAreTheHessianAndGradientOfTheCoulombEnergy) {
 	const double phi = 0.4;
@@ -133,26 +140,15 @@ TEST(ContactMechanics, SlipTermsAreTheHessianAndGradientOfTheCoulombEnergy) {
 	Vector24 F;
 	ASSERT_TRUE(contactTerms(c, bi, bj, K, F));
 	EXPECT_NEAR((K - K.transpose()).norm(), 0.0, 1e-9 * K.norm());
-	// With the normal spring on the exact distance, its force is -kn d0 e at
-	// D = 0 (d0 = the stencil's, 0 here) plus the model's d0 shift: compare
-	// the tangential part alone by taking the stencil's own d0.
-	c.normal.d0 = c.normal.delta * 0;  // the exact energy's distance at D = 0 is the stencil's (0)
+	// Against the exact energy, whose distance at D = 0 is the stencil's own
+	// (0: the vertex lies on the face), the model's d0 must be that too; the
+	// -1e-4 above only set the normal force, hence the limit.
+	c.normal.d0 = 0;
 	ASSERT_TRUE(contactTerms(c, bi, bj, K, F));
-	const double h = 1e-7;
 	Vector24 gradient;
 	Matrix24 hessian;
-	for (int a = 0; a < 24; ++a) {
-		Vector24 e = Vector24::Zero();
-		e(a) = h;
-		gradient(a) = (coulombEnergy(c, bi, bj, e, c.slipLimit) - coulombEnergy(c, bi, bj, -e, c.slipLimit)) / (2 * h);
-		for (int b = 0; b < 24; ++b) {
-			Vector24 f = Vector24::Zero();
-			f(b) = h;
-			hessian(a, b) = (coulombEnergy(c, bi, bj, e + f, c.slipLimit) - coulombEnergy(c, bi, bj, e - f, c.slipLimit) -
-			                 coulombEnergy(c, bi, bj, -e + f, c.slipLimit) + coulombEnergy(c, bi, bj, -e - f, c.slipLimit)) /
-			                (4 * h * h);
-		}
-	}
+	finiteDifferences([&](const Vector24& D) { return coulombEnergy(c, bi, bj, D, c.slipLimit); }, 1e-7, gradient,
+	                  hessian);
 	EXPECT_LT((F + gradient).norm(), 1e-6 * gradient.norm());
 	EXPECT_LT((K - hessian).norm(), 1e-4 * hessian.norm());
 	// The friction force on block i is the limit, against the stretch.
