@@ -93,7 +93,8 @@ void startTrial(Contact& contact, bool formBonds) {
 	contact.stretch.setZero();
 	contact.slipping = false;
 	contact.limitChange = 0;
-	// The first limit: the normal force the contact ended the last step with.
+	// A provisional limit from the normal force the contact ended the last
+	// step with; World::step sets the first pass's from the gap now.
 	contact.slipLimit = slipLimit(contact, contact.trial.normalForce);
 }
 
@@ -269,7 +270,7 @@ ContactStepEnergy contactStepEnergy(const Contact& contact, const Block& blockI,
 		energy.damping += 0.5 * ks * (s1 - s0).squaredNorm();
 	} else {
 		const double r = contact.slipLimit / ks, norm = s1.norm();
-	if (!(norm > 0)) return energy;
+		if (!(norm > 0)) return energy;
 		energy.end += 0.5 * ks * r * r;
 		energy.friction = contact.slipLimit * (norm - r);
 		energy.damping += 0.5 * ks * (r * s1 / norm - s0).squaredNorm();

@@ -486,7 +486,11 @@ World::MemoryUse World::memoryUse() const {
 	use.solver = coupled_.memoryBytes() + capacityBytes(moving_) + capacityBytes(movingIndex_) +
 	             capacityBytes(solutions_) + capacityBytes(motions_) + capacityBytes(ownSystems_) +
 	             capacityBytes(ownSystemOf_) + capacityBytes(solvedAlone_) + capacityBytes(links_) +
-	             capacityBytes(hasSprings_) + capacityBytes(blockUnknowns_);
+	             capacityBytes(hasSprings_) + capacityBytes(blockUnknowns_) + capacityBytes(iterate_) +
+	             capacityBytes(deltas_) + capacityBytes(lines_) + capacityBytes(groupRoot_) + capacityBytes(lineGroup_) +
+	             capacityBytes(groupLines_) + capacityBytes(lineOrder_) + capacityBytes(groupKink_) +
+	             capacityBytes(groupSlope_) + capacityBytes(groupCurvature_) + capacityBytes(groupStep_) +
+	             capacityBytes(contactGroup_) + group_.memoryBytes();
 	return use;
 }
 
@@ -619,6 +623,12 @@ void World::GroupIteration::startIteration() {
 		newPass[g] = 0;
 		forceChange[g] = largestNormalForce[g] = limitChange[g] = largestLimit[g] = 0;
 	}
+}
+
+std::size_t World::GroupIteration::memoryBytes() const {
+	return capacityBytes(done) + capacityBytes(hasContacts) + capacityBytes(swungBack) + capacityBytes(newPass) +
+	       capacityBytes(passes) + capacityBytes(passSolves) + capacityBytes(changes) + capacityBytes(forceChange) +
+	       capacityBytes(largestNormalForce) + capacityBytes(limitChange) + capacityBytes(largestLimit);
 }
 
 bool World::GroupIteration::passConverged(int g, double tolerance) const {

@@ -136,6 +136,7 @@ private:
 		void reset(int groups);
 		void startIteration();
 		bool passConverged(int g, double tolerance) const;
+		std::size_t memoryBytes() const;
 	};
 	GroupIteration group_;
 	std::vector<int> contactGroup_;
