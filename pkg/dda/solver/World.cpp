@@ -952,7 +952,11 @@ double World::step(const IntegratorSettings& settings) {
 					evaluateContact(contact, blocks_[bi], blocks_[bj], Di, Dj);
 					++group_.changes[g];
 				}
-				group_.largestNormalForce[g] = std::max(group_.largestNormalForce[g], std::abs(contact.trial.normalForce));
+				// The force scale of the group: its largest normal force, or
+				// friction limit (an open contact keeps its limit for the pass,
+				// so a group may slip with no normal force at all).
+				group_.largestNormalForce[g] = std::max(
+				    {group_.largestNormalForce[g], std::abs(contact.trial.normalForce), contact.slipLimit});
 				group_.forceChange[g] = std::max(
 				    group_.forceChange[g], (tangentialForce(contact, blocks_[bi], blocks_[bj], Di, Dj) - model).norm());
 			}
