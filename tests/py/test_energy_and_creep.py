@@ -195,3 +195,28 @@ def test_pushed_block_slides_as_coulomb_says(scene, dt):
     expected = 0.5 * acc * (t2 ** 2 - t1 ** 2)
     assert abs((c2[0] - c1[0]) - expected) < 0.02 * expected, (c2[0] - c1[0], expected)
     assert abs(c2[1]) < 1e-9
+
+
+@pytest.mark.parametrize('fs', [1.02, 1.078])
+@pytest.mark.parametrize('shape', [(35.0, 90.0, 90.0, 0.3, 1.0), (30.0, 100.0, 75.0, 2.0, 1.5)],
+                         ids=['symmetric', 'tilted'])
+def test_wedge_that_must_hold_does_not_creep(scene, shape, fs):
+    """A tetrahedral wedge on two planes (plunge of their line, the planes' angles xi
+    and beta, azimuth, tan(phi_B)/tan(phi_A), as test_contact_physics.WEDGES) with
+    each plane's friction set for the Hoek-Bray factor of safety fs: no steady
+    motion, less than 20 um between 0.5 s and 1 s (the issue's wedge crept at 2.1
+    mm/s at FS 1.078 on the earlier contact law)."""
+    plunge, xi, beta, azimuth, ratio = shape
+    geo = S.wedge_geometry(math.radians(plunge), math.radians(xi), math.radians(beta), azimuth=azimuth,
+                           origin=(3.0, -2.0, 10.0))
+    phiA, phiB = S.friction_for_wedge_fs(geo['nA'], geo['nB'], fs, ratio)
+    S.add_block(geo['slabA'], S.rock(math.degrees(phiA)), fixed=True)
+    S.add_block(geo['slabB'], S.rock(math.degrees(phiB)), fixed=True)
+    wedge = S.add_block(geo['wedge'], S.rock(60.0))
+    O.engines = [DDAIntegrator(dt=2e-3, gravity=(0, 0, -G), maxDisplacement=0.02, label='dda')]
+    O.run(250, True)
+    c1 = yade_dda.block(wedge).centroid
+    O.run(250, True)
+    c2 = yade_dda.block(wedge).centroid
+    assert abs(O.time - 1.0) < 1e-9
+    assert S.norm(S.sub(c2, c1)) < 2e-5, (c1, c2)
