@@ -23,8 +23,7 @@ void assembleBlock(const Block& block, const IntegratorSettings& settings, doubl
 
 	for (const FixedPoint& point : block.fixedPoints) {
 		const Matrix3x12 T = displacementMatrix(point.position - block.centroid);
-		const double stiffness = point.stiffness > 0 ? point.stiffness
-		                                             : settings.fixedPointPenaltyFactor * block.material.young * block.size;
+		const double stiffness = fixedPointStiffness(point, block, settings);
 		system.stiffness.noalias() += stiffness * T.transpose() * T;
 		system.force.noalias() += stiffness * T.transpose() * (point.anchor - point.position);
 	}
@@ -47,8 +46,7 @@ void assembleRigidBlock(const Block& block, const IntegratorSettings& settings, 
 	if (!settings.gravity.isZero()) force.head<3>() += block.mass * settings.gravity;
 	for (const FixedPoint& point : block.fixedPoints) {
 		const Matrix3x6 T = displacementMatrix(point.position - block.centroid).leftCols<6>();
-		const double k = point.stiffness > 0 ? point.stiffness
-		                                     : settings.fixedPointPenaltyFactor * block.material.young * block.size;
+		const double k = fixedPointStiffness(point, block, settings);
 		stiffness.noalias() += k * T.transpose() * T;
 		force.noalias() += k * T.transpose() * (point.anchor - point.position);
 	}

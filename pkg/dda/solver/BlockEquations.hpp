@@ -25,6 +25,22 @@ struct BlockSystem {
 	Vector12 force;
 };
 
+// A fixed point's penalty stiffness [N/m]: its own, else the settings' default
+// (fixedPointPenaltyFactor x E x block size).
+inline double fixedPointStiffness(const FixedPoint& point, const Block& block, const IntegratorSettings& settings) {
+	return point.stiffness > 0 ? point.stiffness : settings.fixedPointPenaltyFactor * block.material.young * block.size;
+}
+
+// Kinetic energy 1/2 v^T M v [J] of the rates v with the block's consistent
+// mass matrix (6 x 6 for a rigid block: translation and rotation only).
+inline double kineticEnergy(const Block& block, const Vector12& v) {
+	if (block.rigid) {
+		const Vector6 r = v.head<6>();
+		return 0.5 * r.dot(rigidMassMatrix(block.density(), block.volume, block.secondMoment) * r);
+	}
+	return 0.5 * v.dot(massMatrix(block.density(), block.volume, block.secondMoment) * v);
+}
+
 // Start-of-step velocity: the carried velocity scaled by Shi's dynamic coefficient.
 inline Vector12 startVelocity(const Block& block, const IntegratorSettings& settings) {
 	return settings.velocityRatio * block.velocity;

@@ -244,19 +244,20 @@ ContactStepEnergy contactStepEnergy(const Contact& contact, const Block& blockI,
 	const ContactHistory& trial = contact.trial;
 	const double kn = contact.normalStiffness;
 	const double d0 = contact.normal.d0, d1 = contactGap(contact, Di, Dj);
-	if (!closed(trial.state) || !contact.normal.valid) {
-		// No normal force; an open contact's energy at D = 0 still counts if
-		// it was penetrating (it is lost: contactChanges).
-	} else if (trial.bonded) {
-		energy.start = 0.5 * kn * d0 * d0;
-		energy.end = 0.5 * kn * d1 * d1;
-		energy.damping = 0.5 * kn * (d1 - d0) * (d1 - d0);
-	} else {
-		const double c0 = std::min(0.0, d0), c1 = std::min(0.0, d1);
-		energy.start = 0.5 * kn * c0 * c0;
-		energy.end = 0.5 * kn * c1 * c1;
-		// U(0) - U(D) - U'(D) (0 - D), with U'(D) = kn c1 and d(D) - d(0) = d1 - d0.
-		energy.damping = energy.start - energy.end + kn * c1 * (d1 - d0);
+	// An open contact has no normal spring (what it held at the start of the
+	// step is lost: contactChanges).
+	if (closed(trial.state) && contact.normal.valid) {
+		if (trial.bonded) {
+			energy.start = 0.5 * kn * d0 * d0;
+			energy.end = 0.5 * kn * d1 * d1;
+			energy.damping = 0.5 * kn * (d1 - d0) * (d1 - d0);
+		} else {
+			const double c0 = std::min(0.0, d0), c1 = std::min(0.0, d1);
+			energy.start = 0.5 * kn * c0 * c0;
+			energy.end = 0.5 * kn * c1 * c1;
+			// U(0) - U(D) - U'(D) (0 - D), with U'(D) = kn c1 and d(D) - d(0) = d1 - d0.
+			energy.damping = energy.start - energy.end + kn * c1 * (d1 - d0);
+		}
 	}
 	const TangentialTerm tangential = tangentialTerm(contact);
 	if (tangential == TangentialTerm::None) return energy;

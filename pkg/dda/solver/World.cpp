@@ -554,12 +554,13 @@ void World::solveAloneBlocks(const IntegratorSettings& settings, double dt) {
 void World::assembleContacts(StepStatistics& stats) {
 	Matrix24 stiffness;
 	Vector24 force;
-	for (Contact& contact : store_.contacts()) {
+	for (const Contact& contact : store_.contacts()) {
 		const int bi = contact.key.blockI, bj = contact.key.blockJ;
 		if (!contactTerms(contact, blocks_[bi], blocks_[bj], stiffness, force)) continue;
-		++stats.normalTerms;
-		const TangentialTerm tangential = tangentialTerm(contact);
-		stats.frictionTerms += tangential != TangentialTerm::None;
+		// An open contact may carry its tangential spring alone (its limit is
+		// held for the pass): only closed ones have a normal spring.
+		stats.normalTerms += isClosed(contact);
+		stats.frictionTerms += tangentialTerm(contact) != TangentialTerm::None;
 		const int mi = movingIndex_[bi], mj = movingIndex_[bj];
 		if (mi >= 0) {
 			coupled_.diagonal(mi) += stiffness.topLeftCorner<12, 12>();
@@ -751,21 +752,14 @@ EnergyAccount World::energy() const {
 	for (const Block& block : blocks_) {
 		if (block.fixed) continue;
 		account.gravity -= block.mass * gravity_.dot(block.centroid);
-		if (block.rigid) {
-			const Vector6 v = block.velocity.head<6>();
-			account.kinetic += 0.5 * v.dot(rigidMassMatrix(block.density(), block.volume, block.secondMoment) * v);
-			continue;
-		}
-		account.kinetic +=
-		    0.5 * block.velocity.dot(massMatrix(block.density(), block.volume, block.secondMoment) * block.velocity);
-		if (!block.stress.isZero())
+		account.kinetic += kineticEnergy(block, block.velocity);
+		if (!block.rigid && !block.stress.isZero())
 			account.strain += 0.5 * block.volume * block.stress.dot(block.elasticity().ldlt().solve(block.stress));
 	}
 	return account;
 }
 
-void World::accountStep(const IntegratorSettings& settings, double dt) {
-	(void)dt;
+void World::accountStep(const IntegratorSettings& settings) {
 	// Blocks. Shi's scheme (v1 = 2D/dt - v0, (2/dt^2) M D = (2/dt) M v0 + F(D))
 	// gives 1/2 v1^T M v1 - 1/2 v0^T M v0 = F(D) . D exactly: the kinetic
 	// energy changes by the work of the end-of-step forces over D. Gravity's
@@ -782,13 +776,7 @@ void World::accountStep(const IntegratorSettings& settings, double dt) {
 			// Velocities scaled by velocityRatio at the step's start: the
 			// kinetic energy removed is damping.
 			const double ratio = settings.velocityRatio;
-			const double kinetic =
-			    block.rigid ? 0.5 * block.velocity.head<6>().dot(rigidMassMatrix(block.density(), block.volume,
-			                                                                       block.secondMoment) *
-			                                                      block.velocity.head<6>())
-			                : 0.5 * block.velocity.dot(massMatrix(block.density(), block.volume, block.secondMoment) *
-			                                           block.velocity);
-			energy_.damping += (1 - ratio * ratio) * kinetic;
+			energy_.damping += (1 - ratio * ratio) * kineticEnergy(block, block.velocity);
 		}
 		if (!block.rigid) {
 			const Vector6 strain = D.segment<6>(6);
@@ -797,8 +785,7 @@ void World::accountStep(const IntegratorSettings& settings, double dt) {
 		for (const PointLoad& load : block.loads)
 			energy_.loads += load.force.dot(displacementAt(load.position - block.centroid, D));
 		for (const FixedPoint& point : block.fixedPoints) {
-			const double stiffness = point.stiffness > 0 ? point.stiffness
-			                                             : settings.fixedPointPenaltyFactor * block.material.young * block.size;
+			const double stiffness = fixedPointStiffness(point, block, settings);
 			const Vector3 u = displacementAt(point.position - block.centroid, D);
 			energy_.loads += stiffness * (point.anchor - point.position - u).dot(u);
 		}
@@ -1056,7 +1043,7 @@ double World::step(const IntegratorSettings& settings) {
 	}
 
 	gravity_ = settings.gravity;
-	accountStep(settings, dt);
+	accountStep(settings);
 	const auto phase = Clock::now();
 	// Contacts first (forces from the accepted solution, anchors carried along
 	// with their blocks), then the blocks themselves.

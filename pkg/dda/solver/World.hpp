@@ -118,7 +118,7 @@ private:
 	// Adds the accepted step's dissipation, work of loads and contact springs'
 	// changes to the account (energy_), and records the springs' energy at its
 	// end; called before the contacts and blocks are moved.
-	void accountStep(const IntegratorSettings& settings, double dt);
+	void accountStep(const IntegratorSettings& settings);
 	// Moves the iterate (iterate_) towards the Newton solution (solutions_)
 	// by the step t in (0, 1] that minimises the step's energy along the way
 	// (1 unless a contact slips or crosses a kink of its energy), per group
