@@ -383,6 +383,58 @@ def wedge_geometry(plunge, xi, beta, keel=2.0, arms=(1.0, 1.0), at=0.5, azimuth=
                 nA=nA, nB=nB, line=line, origin=P0)
 
 
+def upward_normal(dip, direction):
+    """Upward unit normal of a plane of dip `dip` and dip direction `direction` [rad]
+    (clockwise from north = +y, x = east): the plane falls towards the horizontal
+    direction (sin direction, cos direction, 0), so its upward normal leans that way
+    by the dip. Inverse of `dip_and_direction`."""
+    return (math.sin(dip) * math.sin(direction), math.sin(dip) * math.cos(direction), math.cos(dip))
+
+
+def wedge_from_dips(dipA, dirA, dipB, dirB, keel=2.0, arms=(1.0, 1.0), **kw):
+    """`wedge_geometry` for a wedge given the way rock engineers give it: the dips and dip
+    directions [rad] of its two joint planes (dip direction clockwise from north = +y).
+
+    The wedge lies above both planes, in the valley they make (z above both is
+    max(z_A, z_B), a convex V whose floor is the line of intersection), and is held
+    by both: its weight pushes it into the keel. The line of intersection has the
+    trend and plunge of `intersection_from_dips`; wedge_geometry's keel runs along
+    (cos psi cos az, cos psi sin az, -sin psi) with az counter-clockwise from +x,
+    so az = 90 deg - trend. In the section perpendicular to the line, xi is the
+    angle between the planes' traces (the valley's opening, `wedge_section_angles`)
+    and beta the bisector's angle from h = (-sin az, cos az, 0), the horizontal to
+    the left looking downhill; wedge_section_angles measures it from l x z = -h,
+    so beta = 180 deg - its beta. wedge_geometry's plane A is the one on the
+    right flank (its face leaves the keel at beta + xi/2 from h, its upward normal
+    leans towards h); when the requested plane A lies on the left the two are
+    built swapped and relabelled, so nA (the upward normal of slab A's top face,
+    pointing into the wedge) has dip dipA and dip direction dirA. `arms` are the
+    wedge's extents from the keel on A and on B [m] (as in wedge_geometry); `kw`
+    goes to wedge_geometry (origin, keel position `at`, slab sizes).
+
+    Adds 'trend', 'plunge', 'azimuth', 'xi', 'beta' (wedge_geometry's angles) [rad]
+    to the dict. Raises ValueError when one reaction would be tensile (the block
+    would slide on one plane and leave the other: not a two-plane wedge).
+    """
+    nA, nB = upward_normal(dipA, dirA), upward_normal(dipB, dirB)
+    RA, RB = wedge_reactions(nA, nB)
+    if not (RA > 0 and RB > 0):
+        raise ValueError('not a two-plane wedge: reactions %g, %g (per unit weight)' % (RA, RB))
+    trend, plunge = intersection_from_dips(dipA, dirA, dipB, dirB)
+    azimuth = math.pi / 2 - trend
+    xi, betaFromRight, _ = wedge_section_angles(nA, nB)
+    beta = math.pi - betaFromRight
+    left = (-math.sin(azimuth), math.cos(azimuth), 0.0)
+    swap = dot(nA, left) < 0
+    geo = wedge_geometry(plunge, xi, beta, keel=keel, arms=tuple(reversed(arms)) if swap else tuple(arms),
+                         azimuth=azimuth, **kw)
+    if swap:
+        for a, b in (('onA', 'onB'), ('slabA', 'slabB'), ('slabATop', 'slabBTop'), ('nA', 'nB')):
+            geo[a], geo[b] = geo[b], geo[a]
+    geo.update(trend=trend, plunge=plunge, azimuth=azimuth, xi=xi, beta=beta)
+    return geo
+
+
 def tetrahedron_volume_centroid(points):
     """Volume [m^3] and centroid [m] of a tetrahedron."""
     a, b, c, d = points
