@@ -364,6 +364,8 @@ BOOST_PYTHON_MODULE(_core) {
 	    .def_readwrite("maxTimeStep", &IntegratorSettings::maxTimeStep)
 	    .def_readwrite("gravity", &IntegratorSettings::gravity)
 	    .def_readwrite("velocityRatio", &IntegratorSettings::velocityRatio)
+	    .def_readwrite("newmarkBeta", &IntegratorSettings::newmarkBeta)
+	    .def_readwrite("newmarkGamma", &IntegratorSettings::newmarkGamma)
 	    .def_readwrite("maxDisplacement", &IntegratorSettings::maxDisplacement)
 	    .def_readwrite("maxDisplacementRatio", &IntegratorSettings::maxDisplacementRatio)
 	    .def_readwrite("timeStepSafety", &IntegratorSettings::timeStepSafety)

@@ -130,6 +130,17 @@ class DDAIntegrator(wrapper.PyRunner):
     - ``gravity`` [m/s^2]: body acceleration.
     - ``velocityRatio`` [-]: Shi's dynamic coefficient in [0, 1]; 1 is fully
       dynamic, 0 static analysis (velocities reset every step).
+    - ``newmarkBeta``, ``newmarkGamma`` [-]: the member of Newmark's family
+      (``D = v0 dt + dt^2 ((1/2 - beta) a0 + beta a1)``, ``v1 = v0 + dt ((1 -
+      gamma) a0 + gamma a1)``). Default 1/2 and 1: Shi's scheme, which damps
+      high frequencies (a bounce loses energy, contacts stop ringing within a
+      step or two). 1/4 and 1/2: average acceleration, second order, keeps
+      the energy of an elastic bounce (contacts take the secant force whose
+      work is exactly minus their spring energy's change). Accepted: 1/2 <=
+      gamma <= 1 and beta = gamma/2 (positions by the trapezoidal rule:
+      every such member dissipates 2 gamma - 1 times the Bregman divergence
+      of the elastic and contact energies, so none creates energy; checked
+      when the engine steps).
     - ``maxDisplacement`` [m]: largest vertex displacement per step; 0 means
       ``maxDisplacementRatio`` x half the largest extent of the scene.
     - ``maxDisplacementRatio`` [-]: Shi's g2, default 0.01.
@@ -176,6 +187,9 @@ class DDAIntegrator(wrapper.PyRunner):
     dt = _Parameter(1e-3, lambda v: _finite('dt', v, 0, lowOpen=True, unit=' s'), 'largest time step [s]')
     gravity = _Parameter((0.0, 0.0, 0.0), _vector3('gravity'), 'body acceleration [m/s^2]')
     velocityRatio = _Parameter(1.0, lambda v: _finite('velocityRatio', v, 0, 1), "Shi's dynamic coefficient [-]")
+    newmarkBeta = _Parameter(0.5, lambda v: _finite('newmarkBeta', v, 0.25, 0.5),
+                             "Newmark's beta [-]: 1/2 with gamma 1 is Shi's scheme, 1/4 with gamma 1/2 average acceleration")
+    newmarkGamma = _Parameter(1.0, lambda v: _finite('newmarkGamma', v, 0.5, 1), "Newmark's gamma [-]")
     maxDisplacement = _Parameter(0.0, lambda v: _finite('maxDisplacement', v, 0, unit=' m'),
                                  'largest vertex displacement per step [m]; 0 = use maxDisplacementRatio')
     maxDisplacementRatio = _Parameter(0.01, lambda v: _finite('maxDisplacementRatio', v, 0, 1, lowOpen=True),
@@ -202,7 +216,7 @@ class DDAIntegrator(wrapper.PyRunner):
     reuseCandidatePairs = _Parameter(True, lambda v: bool(v),
                                      'diagnostic: reuse broad-phase candidate pairs while blocks rest (same contacts)')
 
-    _names = ('dt', 'gravity', 'velocityRatio', 'maxDisplacement', 'maxDisplacementRatio', 'timeStepGrowth',
+    _names = ('dt', 'gravity', 'velocityRatio', 'newmarkBeta', 'newmarkGamma', 'maxDisplacement', 'maxDisplacementRatio', 'timeStepGrowth',
               'maxStepCuts', 'fixedPointPenaltyFactor', 'threads', 'syncPeriod', 'contactDistance',
               'contactPenaltyFactor', 'shearStiffnessRatio', 'maxOpenCloseIterations', 'openCloseShrink',
               'collider',
@@ -242,6 +256,8 @@ def _settings(params):
     settings.maxTimeStep = params['dt']
     settings.gravity = params['gravity']
     settings.velocityRatio = params['velocityRatio']
+    settings.newmarkBeta = params['newmarkBeta']
+    settings.newmarkGamma = params['newmarkGamma']
     settings.maxDisplacement = params['maxDisplacement']
     settings.maxDisplacementRatio = params['maxDisplacementRatio']
     settings.timeStepGrowth = params['timeStepGrowth']

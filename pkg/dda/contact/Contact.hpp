@@ -78,12 +78,20 @@ struct Contact {
 	double cohesionForce = 0;    // bond's shear strength beyond friction [N]
 	double tensileForce = 0;     // bond's tensile strength [N]
 	bool isNew = true;           // no history was found
+	// The time scheme's weights (IntegratorSettings::newmarkGamma = gamma;
+	// ContactEquations.hpp): the step's equations carry the normal spring
+	// times springWeight = (2 gamma - 1) / gamma, its secant (energy-
+	// conserving) force times secantWeight = 2 (1 - gamma) / gamma and the
+	// tangential spring times 1 / gamma; the physical force is gamma times
+	// the equations'. Shi's scheme: 1, 0 and gamma = 1.
+	double springWeight = 1, secantWeight = 0, gamma = 1;
 	// Within a step (ContactEquations.hpp): the tangential stretch s [m] at
 	// the last trial solution and whether it is past the limit (slipping);
 	// the limit L [N] of the tangential spring, fixed while the step's energy
 	// is minimised and updated from the normal force between such passes,
 	// and its last change [N]; open <-> closed changes of the iteration.
 	Vector3 stretch = Vector3::Zero();
+	double trialGap = 0;  // linearised gap at the last trial solution [m]
 	bool slipping = false;
 	double slipLimit = 0;
 	double limitChange = 0;

@@ -6,15 +6,62 @@
 
 namespace dda {
 
-void assembleBlock(const Block& block, const IntegratorSettings& settings, double dt, BlockSystem& system) {
+double massProduct(const Block& block, const Vector12& x, const Vector12& y) {
+	if (block.rigid)
+		return x.head<6>().dot(rigidMassMatrix(block.density(), block.volume, block.secondMoment) * y.head<6>());
+	return x.dot(massMatrix(block.density(), block.volume, block.secondMoment) * y);
+}
+
+Vector12 restForce(const Block& block, const IntegratorSettings& settings) {
+	Vector12 force = Vector12::Zero();
+	if (!block.rigid) force.segment<6>(6) -= block.volume * block.stress;
+	force.head<3>() += block.mass * settings.gravity;
+	for (const FixedPoint& point : block.fixedPoints) {
+		const Matrix3x12 T = displacementMatrix(point.position - block.centroid);
+		force.noalias() += fixedPointStiffness(point, block, settings) * T.transpose() * (point.anchor - point.position);
+	}
+	for (const PointLoad& load : block.loads)
+		force.noalias() += displacementMatrix(load.position - block.centroid).transpose() * load.force;
+	if (block.rigid) force.tail<6>().setZero();
+	return force;
+}
+
+Vector12 accelerationOf(const Block& block, const Vector12& force) {
+	Vector12 a = Vector12::Zero();
+	if (block.rigid)
+		a.head<6>() = rigidMassMatrix(block.density(), block.volume, block.secondMoment).llt().solve(force.head<6>());
+	else
+		a = massMatrix(block.density(), block.volume, block.secondMoment).llt().solve(force);
+	return a;
+}
+
+namespace {
+// Newmark's inertia: K += (1 / (beta dt^2)) M, F += M (v0 / (beta dt) +
+// (1 / (2 beta) - 1) a0); Shi's (beta = 1/2) written as before, (2/dt^2) M
+// and (2/dt) M v0, so that its results stay bitwise those of earlier versions.
+template <typename Mass, typename Stiffness, typename Force, typename Rates>
+void addInertia(const Mass& mass, const Rates& v0, const Rates& a0, const IntegratorSettings& settings, double dt,
+                Stiffness&& stiffness, Force&& force) {
+	if (settings.shiScheme()) {
+		stiffness.noalias() = (2 / (dt * dt)) * mass;
+		force.noalias() = (2 / dt) * (mass * v0);
+		return;
+	}
+	const double beta = settings.newmarkBeta;
+	stiffness.noalias() = (1 / (beta * dt * dt)) * mass;
+	force.noalias() = mass * ((1 / (beta * dt)) * v0 + (0.5 / beta - 1) * a0);
+}
+}  // namespace
+
+void assembleBlock(const Block& block, const IntegratorSettings& settings, double dt, const Vector12& a0,
+                   BlockSystem& system) {
 	if (block.rigid) {
-		assembleRigidBlock(block, settings, dt, system);
+		assembleRigidBlock(block, settings, dt, a0, system);
 		return;
 	}
 	const Vector12 v0 = startVelocity(block, settings);
 	const Matrix12 mass = massMatrix(block.density(), block.volume, block.secondMoment);
-	system.stiffness.noalias() = (2 / (dt * dt)) * mass;
-	system.force.noalias() = (2 / dt) * (mass * v0);
+	addInertia(mass, v0, a0, settings, dt, system.stiffness, system.force);
 
 	system.stiffness.block<6, 6>(6, 6).noalias() += block.volume * block.elasticity();
 	system.force.segment<6>(6).noalias() -= block.volume * block.stress;
@@ -31,18 +78,19 @@ void assembleBlock(const Block& block, const IntegratorSettings& settings, doubl
 		system.force.noalias() += displacementMatrix(load.position - block.centroid).transpose() * load.force;
 }
 
-void assembleRigidBlock(const Block& block, const IntegratorSettings& settings, double dt, BlockSystem& system) {
+void assembleRigidBlock(const Block& block, const IntegratorSettings& settings, double dt, const Vector12& a0,
+                        BlockSystem& system) {
 	// Only the translation-rotation rows and columns are computed; the strain
 	// part of the 12x12 system is zero and never read (solveBlock and
 	// CoupledSystem take the first 6 unknowns of a rigid block).
 	const Vector6 v0 = startVelocity(block, settings).head<6>();
+	const Vector6 a06 = a0.head<6>();
 	const Matrix6 mass = rigidMassMatrix(block.density(), block.volume, block.secondMoment);
 	system.stiffness.setZero();
 	system.force.setZero();
 	auto stiffness = system.stiffness.topLeftCorner<6, 6>();
 	auto force = system.force.head<6>();
-	stiffness.noalias() = (2 / (dt * dt)) * mass;
-	force.noalias() = (2 / dt) * (mass * v0);
+	addInertia(mass, v0, a06, settings, dt, stiffness, force);
 	if (!settings.gravity.isZero()) force.head<3>() += block.mass * settings.gravity;
 	for (const FixedPoint& point : block.fixedPoints) {
 		const Matrix3x6 T = displacementMatrix(point.position - block.centroid).leftCols<6>();
@@ -52,6 +100,12 @@ void assembleRigidBlock(const Block& block, const IntegratorSettings& settings, 
 	}
 	for (const PointLoad& load : block.loads)
 		force.noalias() += displacementMatrix(load.position - block.centroid).leftCols<6>().transpose() * load.force;
+}
+
+Vector12 endVelocity(const Vector12& D, const Vector12& v0, double dt) {
+	// v0 + dt ((1 - gamma) a0 + gamma a1) with beta = gamma/2 is exactly this
+	// (the positions follow the trapezoidal rule, D = dt (v0 + v1)/2).
+	return (2 / dt) * D - v0;
 }
 
 Vector12 solveBlock(const Block& block, const BlockSystem& system) {
@@ -98,7 +152,7 @@ BlockMotion blockMotion(const Block& block, const Vector12& D) {
 	return motion;
 }
 
-void applyStep(Block& block, const Vector12& D, const Vector12& v0, double dt) {
+void applyStep(Block& block, const Vector12& D, const Vector12& velocity) {
 	const BlockMotion move = blockMotion(block, D);
 	const Matrix3& rotation = move.rotation;
 	const Matrix3& deformation = move.deformation;
@@ -115,7 +169,7 @@ void applyStep(Block& block, const Vector12& D, const Vector12& v0, double dt) {
 		// which is not applied), the second moments turn with the block;
 		// stress, strain and strain rates stay exactly zero.
 		block.secondMoment = rotation * block.secondMoment * rotation.transpose();
-		block.velocity.head<6>() = (2 / dt) * D.head<6>() - v0.head<6>();
+		block.velocity.head<6>() = velocity.head<6>();
 		block.velocity.tail<6>().setZero();
 		return;
 	}
@@ -127,10 +181,9 @@ void applyStep(Block& block, const Vector12& D, const Vector12& v0, double dt) {
 	block.secondMoment = jacobian * deformation * block.secondMoment * deformation.transpose();
 
 	// End velocity of the step; tensors follow the block's rotation.
-	Vector12 velocity = (2 / dt) * D - v0;
-	const Matrix3 strainRate = rotation * strainTensor(velocity.segment<6>(6)) * rotation.transpose();
-	velocity.segment<6>(6) = strainVoigt(strainRate);
 	block.velocity = velocity;
+	const Matrix3 strainRate = rotation * strainTensor(velocity.segment<6>(6)) * rotation.transpose();
+	block.velocity.segment<6>(6) = strainVoigt(strainRate);
 
 	const Vector6 strainIncrement = D.segment<6>(6);
 	block.stress = stressVoigt(rotation * stressTensor(block.stress) * rotation.transpose()) + block.elasticity() * strainIncrement;

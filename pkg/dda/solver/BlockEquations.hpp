@@ -1,18 +1,24 @@
 // The equations of one block for one time step, without contacts, and the
 // update of its state once the step is accepted.
 //
-// Shi's time scheme assumes a constant acceleration over the step:
-//   D = v0 dt + a dt^2 / 2,   v1 = 2 D / dt - v0.
-// The inertia force -rho a then contributes (2/dt^2) M D = (2/dt) M v0 + ...,
-// with M the consistent mass matrix (Displacement.hpp). Further terms, each the
-// derivative of a potential energy with respect to D:
+// Newmark's family (IntegratorSettings::newmarkBeta, newmarkGamma):
+//   D = v0 dt + dt^2 ((1/2 - beta) a0 + beta a1),
+//   v1 = v0 + dt ((1 - gamma) a0 + gamma a1),
+// with a1 the end-of-step acceleration, M a1 = F(D). Solving the first for
+// a1 makes the inertia force -M a1 contribute
+//   (1 / (beta dt^2)) M D = M (v0 / (beta dt) + (1 / (2 beta) - 1) a0) + F(D),
+// M the consistent mass matrix (Displacement.hpp). Shi's scheme is beta =
+// 1/2, gamma = 1 (a constant acceleration over the step): (2/dt^2) M D =
+// (2/dt) M v0 + F(D), v1 = 2 D / dt - v0, and a0 drops out. Further terms of
+// F, each the derivative of a potential energy with respect to D:
 //   elastic strain energy     V/2 eps^T E eps        -> K_ee += V E
 //   stress of the last step   V sigma^T eps          -> F_e  -= V sigma
 //   gravity                   -m g . t               -> F_t  += m g
 //   fixed point (penalty k)   k/2 |x + T(x)D - a|^2  -> K += k T^T T, F += k T^T (a - x)
 //   point load f at x         -f . T(x) D            -> F += T^T f
-// The scheme is exact for a constant acceleration (free fall) and, being
-// Newmark with gamma = 1, dissipates high frequencies: it never creates energy.
+// Shi's scheme is exact for a constant acceleration (free fall) and, being
+// Newmark with gamma = 1, dissipates high frequencies: it never creates
+// energy. Average acceleration (1/4, 1/2) keeps a linear system's energy.
 #pragma once
 
 #include "IntegratorSettings.hpp"
@@ -41,17 +47,38 @@ inline double kineticEnergy(const Block& block, const Vector12& v) {
 	return 0.5 * v.dot(massMatrix(block.density(), block.volume, block.secondMoment) * v);
 }
 
+// x^T M y with the block's consistent mass matrix (6 x 6 for a rigid block).
+double massProduct(const Block& block, const Vector12& x, const Vector12& y);
+
 // Start-of-step velocity: the carried velocity scaled by Shi's dynamic coefficient.
 inline Vector12 startVelocity(const Block& block, const IntegratorSettings& settings) {
 	return settings.velocityRatio * block.velocity;
 }
 
-void assembleBlock(const Block& block, const IntegratorSettings& settings, double dt, BlockSystem& system);
+// The block's own forces at D = 0 without inertia [N, N m, N m]: gravity,
+// the stress of the last step, fixed-point springs and point loads.
+Vector12 restForce(const Block& block, const IntegratorSettings& settings);
+// The acceleration M^-1 f of a force f on the block [m/s^2, rad/s^2, 1/s^2]
+// (a rigid block's strain part is zero).
+Vector12 accelerationOf(const Block& block, const Vector12& force);
+
+// The block's system for the step: inertia (Newmark's, above, from the start
+// velocity startVelocity(block, settings) and the start acceleration a0,
+// which Shi's scheme does not read) and its own forces.
+void assembleBlock(const Block& block, const IntegratorSettings& settings, double dt, const Vector12& a0,
+                   BlockSystem& system);
 // A rigid block's system (assembleBlock calls it): inertia, gravity, fixed
 // points and loads in the 6 translation-rotation unknowns only, computed as
 // 6x6 (rigidMassMatrix, T's first 6 columns); no elastic or stress term. The
 // strain rows and columns of `system` are left zero.
-void assembleRigidBlock(const Block& block, const IntegratorSettings& settings, double dt, BlockSystem& system);
+void assembleRigidBlock(const Block& block, const IntegratorSettings& settings, double dt, const Vector12& a0,
+                        BlockSystem& system);
+
+// End-of-step velocity of the step's D from the start velocity v0, in the
+// start configuration: v1 = 2 D / dt - v0 for every member with beta =
+// gamma/2, the only ones World accepts (their positions follow the
+// trapezoidal rule, D = dt (v0 + v1)/2).
+Vector12 endVelocity(const Vector12& D, const Vector12& v0, double dt);
 
 // Solves the block's system. Without fixed points the translations decouple
 // (the first moments about the centroid vanish), leaving a 3x3 diagonal and a
@@ -80,6 +107,7 @@ BlockMotion blockMotion(const Block& block, const Vector12& D);
 // (the old stress rotated with the block plus E times the strain increment).
 // A rigid block: rotation and translation only; volume kept, second moments
 // turned (R J R^T), stress, strain and strain rates left exactly zero.
-void applyStep(Block& block, const Vector12& D, const Vector12& startVelocity, double dt);
+// `velocity` is the end velocity (endVelocity) in the start configuration.
+void applyStep(Block& block, const Vector12& D, const Vector12& velocity);
 
 }  // namespace dda

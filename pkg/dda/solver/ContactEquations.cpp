@@ -64,6 +64,41 @@ Matrix3 slipStiffness(const Contact& contact) {
 
 }  // namespace
 
+double normalSpringEnergy(bool bonded, double kn, double d) {
+	const double c = bonded ? d : std::min(0.0, d);
+	return 0.5 * kn * c * c;
+}
+
+NormalSecant normalSecant(bool bonded, double kn, double d0, double d) {
+	// Closed at both ends (or bonded): U is quadratic there, its secant
+	// slope the mean of the two ends' slopes, kn (d + d0) / 2.
+	if (bonded || (d0 <= 0 && d <= 0)) return {0.5 * kn * (d + d0), 0.5 * kn};
+	if (d0 <= 0) {
+		// Released within the step: (0 - U(d0)) / (d - d0), d - d0 >= -d0 > 0.
+		if (d0 == 0) return {0.0, 0.0};
+		const double q = d - d0;
+		return {-0.5 * kn * d0 * d0 / q, 0.5 * kn * d0 * d0 / (q * q)};
+	}
+	if (d >= 0) return {0.0, 0.0};  // apart at both ends
+	// Closing within the step: U(d) / (d - d0), d - d0 <= -d0 < 0.
+	const double q = d - d0;
+	return {0.5 * kn * d * d / q, 0.5 * kn * (d * d - 2 * d * d0) / (q * q)};
+}
+
+bool hasNormalTerms(const Contact& contact) {
+	if (!contact.normal.valid) return false;
+	return closed(contact.trial.state) || (contact.secantWeight > 0 && contact.normal.d0 < 0);
+}
+
+double normalModelError(const Contact& contact, const Vector12& Di, const Vector12& Dj) {
+	if (!(contact.secantWeight > 0) || !contact.normal.valid) return 0.0;
+	const double kn = contact.normalStiffness, d0 = contact.normal.d0;
+	const double d = contactGap(contact, Di, Dj), dk = contact.trialGap;
+	const bool bonded = contact.trial.bonded;
+	const NormalSecant at = normalSecant(bonded, kn, d0, d), model = normalSecant(bonded, kn, d0, dk);
+	return contact.gamma * contact.secantWeight * std::abs(at.value - (model.value + model.slope * (d - dk)));
+}
+
 void prepareContact(Contact& contact, const Block& blockI, const Block& blockJ, const IntegratorSettings& settings) {
 	const double stiffnessI = blockI.material.young * blockI.size;
 	const double stiffnessJ = blockJ.material.young * blockJ.size;
@@ -73,6 +108,11 @@ void prepareContact(Contact& contact, const Block& blockI, const Block& blockJ, 
 	contact.cohesionForce = std::min(blockI.material.cohesion, blockJ.material.cohesion) * contact.area;
 	contact.tensileForce = std::min(blockI.material.tensileStrength, blockJ.material.tensileStrength) * contact.area;
 	contact.normal = linearizeNormalDistance(contact.geometry.stencil, blockI.centroid, blockJ.centroid);
+	contact.trialGap = contact.normal.d0;
+	const double gamma = settings.newmarkGamma;
+	contact.gamma = gamma;
+	contact.springWeight = (2 * gamma - 1) / gamma;
+	contact.secantWeight = 2 * (1 - gamma) / gamma;
 }
 
 void startTrial(Contact& contact, bool formBonds) {
@@ -111,23 +151,38 @@ bool contactTerms(const Contact& contact, const Block& blockI, const Block& bloc
                   Vector24& force) {
 	const ContactHistory& trial = contact.trial;
 	const TangentialTerm tangential = tangentialTerm(contact);
-	if (!closed(trial.state) && tangential == TangentialTerm::None) return false;
+	const bool normalTerms = hasNormalTerms(contact);
+	if (!normalTerms && tangential == TangentialTerm::None) return false;
 	stiffness.setZero();
 	force.setZero();
-	if (closed(trial.state)) {
+	if (normalTerms) {
 		const Vector24 e = stacked(contact.normal.ei, contact.normal.ej);
 		const double kn = contact.normalStiffness;
-		stiffness.noalias() = kn * e * e.transpose();
-		force.noalias() = -kn * contact.normal.d0 * e;
+		if (contact.secantWeight > 0) {
+			// springWeight x the spring (while closed) plus secantWeight x the
+			// secant force, expanded about the trial gap d_k.
+			const double d0 = contact.normal.d0, dk = contact.trialGap;
+			const NormalSecant h = normalSecant(trial.bonded, kn, d0, dk);
+			const double spring = closed(trial.state) ? contact.springWeight * kn : 0.0;
+			const double curvature = spring + contact.secantWeight * h.slope;
+			stiffness.noalias() = curvature * e * e.transpose();
+			force.noalias() = (-spring * d0 + contact.secantWeight * (h.slope * (dk - d0) - h.value)) * e;
+		} else {
+			stiffness.noalias() = kn * e * e.transpose();
+			force.noalias() = -kn * contact.normal.d0 * e;
+		}
 	}
 	if (tangential == TangentialTerm::None) return true;
+	// The tangential spring's force in the step's equations is 1/gamma times
+	// its physical one (exactly 1 for Shi's scheme).
+	const double weight = 1 / contact.gamma;
 	const Eigen::Matrix<double, 3, 24> G = relativeDisplacementMatrix(blockI, trial.anchorI, blockJ, trial.anchorJ);
 	const Vector3 separation = trial.anchorI - trial.anchorJ;
 	if (tangential == TangentialTerm::ShearSpring) {
 		const Matrix3 P = tangentProjector(contact.geometry.normal);
 		const double ks = contact.shearStiffness;
-		stiffness.noalias() += ks * G.transpose() * P * G;
-		force.noalias() -= ks * G.transpose() * (P * separation);
+		stiffness.noalias() += (weight * ks) * G.transpose() * P * G;
+		force.noalias() -= (weight * ks) * G.transpose() * (P * separation);
 	} else {
 		// G^T C G as the outer product of G^T m with itself (symmetric and
 		// positive semi-definite to round-off; see slipStiffness).
@@ -135,13 +190,26 @@ bool contactTerms(const Contact& contact, const Block& blockI, const Block& bloc
 		if (!(stretch > 0)) return true;  // no slip direction: nothing to add
 		const Vector3 l = contact.stretch / stretch;
 		const Vector3 m = contact.geometry.normal.cross(l).normalized();
-		const double c = contact.slipLimit / stretch;
+		const double c = weight * contact.slipLimit / stretch;
 		const Vector24 Gm = G.transpose() * m;
 		stiffness.noalias() += c * Gm * Gm.transpose();
-		force.noalias() -= G.transpose() * (contact.slipLimit * l) + (c * m.dot(separation)) * Gm;
+		force.noalias() -= G.transpose() * ((weight * contact.slipLimit) * l) + (c * m.dot(separation)) * Gm;
 	}
 	return true;
 }
+
+namespace {
+// The contact's normal force over the step [N], compression positive: the
+// spring's -kn d while closed (Shi's scheme), else gamma times the
+// equations' force, (2 gamma - 1) kn max(0, -d) - 2 (1 - gamma) h(d).
+double meanNormalForce(const Contact& contact, bool closedNow, double gap) {
+	const double kn = contact.normalStiffness;
+	const double spring = closedNow ? -kn * gap : 0.0;
+	if (!(contact.secantWeight > 0) || !contact.normal.valid) return spring;
+	const double secant = normalSecant(contact.trial.bonded, kn, contact.normal.d0, gap).value;
+	return contact.gamma * (contact.springWeight * spring - contact.secantWeight * secant);
+}
+}  // namespace
 
 bool evaluateContact(Contact& contact, const Block& blockI, const Block& blockJ, const Vector12& Di,
                      const Vector12& Dj) {
@@ -152,7 +220,8 @@ bool evaluateContact(Contact& contact, const Block& blockI, const Block& blockJ,
 	// A bond holds in tension up to its strength; beyond, it breaks for good.
 	if (trial.bonded && kn * gap > contact.tensileForce) trial.bonded = false;
 	bool closedNow = contact.normal.valid && (trial.bonded || gap < 0);
-	trial.normalForce = closedNow ? -kn * gap : 0.0;
+	contact.trialGap = gap;
+	trial.normalForce = meanNormalForce(contact, closedNow, gap);
 	contact.stretch.setZero();
 	contact.slipping = false;
 	if (contact.slipLimit > 0 || trial.bonded) {
@@ -162,7 +231,7 @@ bool evaluateContact(Contact& contact, const Block& blockI, const Block& blockJ,
 			// the contact holds no tension, and its limit loses the cohesion.
 			trial.bonded = false;
 			closedNow = contact.normal.valid && gap < 0;
-			trial.normalForce = closedNow ? -kn * gap : 0.0;
+			trial.normalForce = meanNormalForce(contact, closedNow, gap);
 			contact.slipLimit = slipLimit(contact, trial.normalForce);
 		}
 		contact.stretch = s;
@@ -205,14 +274,15 @@ Vector3 tangentialForce(const Contact& contact, const Block& blockI, const Block
 
 double ContactLine::derivative(double t) const {
 	const double gapAt = gap + t * gapRate;
-	double value = normalStiffness * (bonded ? gapAt : std::min(0.0, gapAt)) * gapRate;
+	double value = springWeight * normalStiffness * (bonded ? gapAt : std::min(0.0, gapAt)) * gapRate;
+	if (secantWeight > 0) value += secantWeight * normalSecant(bonded, normalStiffness, startGap, gapAt).value * gapRate;
 	if (tangential) {
 		const Vector3 s = stretch + t * stretchRate;
 		const double norm = s.norm();
 		if (shearStiffness * norm <= limit)
-			value += shearStiffness * s.dot(stretchRate);
+			value += tangentialWeight * shearStiffness * s.dot(stretchRate);
 		else
-			value += limit * s.dot(stretchRate) / norm;
+			value += tangentialWeight * limit * s.dot(stretchRate) / norm;
 	}
 	return value;
 }
@@ -227,6 +297,10 @@ ContactLine contactLine(const Contact& contact, const Block& blockI, const Block
 	line.normalStiffness = contact.normalStiffness;
 	line.shearStiffness = contact.shearStiffness;
 	line.bonded = trial.bonded;
+	line.startGap = contact.normal.d0;
+	line.springWeight = contact.springWeight;
+	line.secantWeight = contact.secantWeight;
+	line.tangentialWeight = 1 / contact.gamma;
 	line.limit = contact.slipLimit;
 	line.tangential = line.limit > 0;
 	if (line.tangential) {
@@ -244,20 +318,17 @@ ContactStepEnergy contactStepEnergy(const Contact& contact, const Block& blockI,
 	const ContactHistory& trial = contact.trial;
 	const double kn = contact.normalStiffness;
 	const double d0 = contact.normal.d0, d1 = contactGap(contact, Di, Dj);
-	// An open contact has no normal spring (what it held at the start of the
-	// step is lost: contactChanges).
-	if (closed(trial.state) && contact.normal.valid) {
-		if (trial.bonded) {
-			energy.start = 0.5 * kn * d0 * d0;
-			energy.end = 0.5 * kn * d1 * d1;
-			energy.damping = 0.5 * kn * (d1 - d0) * (d1 - d0);
-		} else {
-			const double c0 = std::min(0.0, d0), c1 = std::min(0.0, d1);
-			energy.start = 0.5 * kn * c0 * c0;
-			energy.end = 0.5 * kn * c1 * c1;
-			// U(0) - U(D) - U'(D) (0 - D), with U'(D) = kn c1 and d(D) - d(0) = d1 - d0.
-			energy.damping = energy.start - energy.end + kn * c1 * (d1 - d0);
-		}
+	// The spring's energy U at both ends, and its Bregman divergence B =
+	// U(0) - U(D) - U'(D) (0 - D) times 2 gamma - 1 (the secant force's work
+	// is -(U(D) - U(0)) exactly: it dissipates nothing). A contact that
+	// opened in the step (Shi's scheme: no force at its end) lost what it
+	// held: B = U(d0).
+	if (contact.normal.valid) {
+		const double c0 = trial.bonded ? d0 : std::min(0.0, d0), c1 = trial.bonded ? d1 : std::min(0.0, d1);
+		energy.start = 0.5 * kn * c0 * c0;
+		energy.end = 0.5 * kn * c1 * c1;
+		// U'(D) = kn c1 and d(D) - d(0) = d1 - d0.
+		energy.damping = (2 * contact.gamma - 1) * (energy.start - energy.end + kn * c1 * (d1 - d0));
 	}
 	const TangentialTerm tangential = tangentialTerm(contact);
 	if (tangential == TangentialTerm::None) return energy;

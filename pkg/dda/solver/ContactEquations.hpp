@@ -106,11 +106,33 @@ Vector3 tangentialForce(const Contact& contact, const Block& blockI, const Block
 // Linearised gap for the unknowns [m].
 double contactGap(const Contact& contact, const Vector12& Di, const Vector12& Dj);
 
+// The normal spring's energy U(d) [J]: kn/2 min(0, d)^2, bonded kn/2 d^2.
+double normalSpringEnergy(bool bonded, double kn, double d);
+// The secant slope h(d) = (U(d) - U(d0)) / (d - d0) of U from the start gap
+// d0 [N] (U'(d0) at d = d0), and its derivative h'(d) >= 0 [N/m]. A force
+// -h(d) e over the step does work -(U(d) - U(d0)) exactly (d is linear in
+// D): the discrete gradient that makes a contact conserve energy under the
+// trapezoidal rule (Gonzalez; Laursen and Chawla for frictionless contact).
+// h is non-decreasing in d (U convex), so its integral, the secant's
+// energy, is convex: the step stays one convex minimisation.
+struct NormalSecant {
+	double value, slope;
+};
+NormalSecant normalSecant(bool bonded, double kn, double d0, double d);
+// Whether the contact's normal force enters the step's equations: closed
+// at the trial solution, or (secant weight > 0) compressed at the start.
+bool hasNormalTerms(const Contact& contact);
+// The physical normal force by which the secant's Newton model at the last
+// trial gap misses the secant force at (Di, Dj) [N]; 0 for Shi's scheme.
+double normalModelError(const Contact& contact, const Vector12& Di, const Vector12& Dj);
+
 // The derivative of the contact's energy (normal and tangential, at the
 // limit of its trial state) along D = D_k + t Delta at t, for the step's line
 // search: `line` holds the gap and stretch at t = 0 and their rates.
 struct ContactLine {
 	double gap = 0, gapRate = 0;   // d(D_k) [m], e . Delta [m]
+	double startGap = 0;           // d(0) [m]
+	double springWeight = 1, secantWeight = 0, tangentialWeight = 1;  // the scheme's (Contact)
 	Vector3 stretch = Vector3::Zero(), stretchRate = Vector3::Zero();  // s(D_k), P G Delta [m]
 	double normalStiffness = 0, shearStiffness = 0;  // [N/m]
 	double limit = 0;      // L [N]; 0: no tangential force

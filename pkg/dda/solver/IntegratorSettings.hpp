@@ -14,6 +14,23 @@ struct IntegratorSettings {
 	// Shi's dynamic coefficient in [0, 1]: the fraction of the end velocity that
 	// carries into the next step. 1 = fully dynamic, 0 = static analysis.
 	double velocityRatio = 1;
+	// The member of Newmark's family the step uses (BlockEquations.hpp):
+	//   D = v0 dt + dt^2 ((1/2 - beta) a0 + beta a1),
+	//   v1 = v0 + dt ((1 - gamma) a0 + gamma a1).
+	// Shi's scheme, beta = 1/2 and gamma = 1, is the default: a constant
+	// acceleration a1 over the step, first order, damping high frequencies
+	// completely (a contact's ringing dies within a step or two). Average
+	// acceleration, beta = 1/4 and gamma = 1/2, is second order and keeps
+	// the energy of a linear system exactly; its contacts take the secant
+	// (discrete-gradient) force, so an elastic bounce keeps its energy too
+	// (ContactEquations.hpp). Accepted: 1/2 <= gamma <= 1 and beta =
+	// gamma/2 (the members whose positions follow the trapezoidal rule;
+	// each dissipates 2 gamma - 1 times the Bregman divergence of the
+	// elastic and contact energies, so none creates energy) [-].
+	double newmarkBeta = 0.5;
+	double newmarkGamma = 1.0;
+	// Shi's scheme needs no start-of-step acceleration a0.
+	bool shiScheme() const { return newmarkBeta == 0.5 && newmarkGamma == 1.0; }
 	// Largest vertex displacement allowed in one step [m]. When <= 0 it is
 	// maxDisplacementRatio x half the largest extent of the scene's bounding box
 	// (Shi's g2 x w0), measured at the first step after blocks were added.

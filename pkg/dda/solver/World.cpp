@@ -289,6 +289,13 @@ void World::validateSettings(const IntegratorSettings& s) const {
 		message << "gravity must be finite";
 	else if (!(s.velocityRatio >= 0 && s.velocityRatio <= 1))
 		message << "velocityRatio must lie in [0, 1], got " << s.velocityRatio;
+	else if (!(s.newmarkGamma >= 0.5 && s.newmarkGamma <= 1))
+		message << "newmarkGamma must lie in [0.5, 1] (unconditionally stable, at most first-order damped), got "
+		        << s.newmarkGamma;
+	else if (!(std::abs(s.newmarkBeta - 0.5 * s.newmarkGamma) <= 1e-12))
+		message << "newmarkBeta must be newmarkGamma / 2 (the members whose positions follow the trapezoidal rule, "
+		        << "for which no member creates energy; Shi's scheme is 1/2 and 1, average acceleration 1/4 and "
+		        << "1/2), got " << s.newmarkBeta << " with newmarkGamma " << s.newmarkGamma;
 	else if (!(std::isfinite(s.maxDisplacement)))
 		message << "maxDisplacement must be finite, got " << s.maxDisplacement << " m";
 	else if (!(s.maxDisplacementRatio > 0 && std::isfinite(s.maxDisplacementRatio)))
@@ -490,7 +497,7 @@ World::MemoryUse World::memoryUse() const {
 	             capacityBytes(deltas_) + capacityBytes(lines_) + capacityBytes(groupRoot_) + capacityBytes(lineGroup_) +
 	             capacityBytes(groupLines_) + capacityBytes(lineOrder_) + capacityBytes(groupKink_) +
 	             capacityBytes(groupSlope_) + capacityBytes(groupCurvature_) + capacityBytes(groupStep_) +
-	             capacityBytes(contactGroup_) + group_.memoryBytes();
+	             capacityBytes(contactGroup_) + capacityBytes(startAccelerations_) + group_.memoryBytes();
 	return use;
 }
 
@@ -500,7 +507,7 @@ void World::buildSystemStructure(int movingBlocks, StepStatistics& stats) {
 	for (int k = 0; k < movingBlocks; ++k) hasSprings_[k] = !blocks_[moving_[k]].fixedPoints.empty();
 	for (const Contact& contact : store_.contacts()) {
 		// No terms (open, and no tangential spring): couples nothing.
-		if (contact.trial.state == ContactState::Open && tangentialTerm(contact) == TangentialTerm::None) continue;
+		if (!hasNormalTerms(contact) && tangentialTerm(contact) == TangentialTerm::None) continue;
 		const int mi = movingIndex_[contact.key.blockI], mj = movingIndex_[contact.key.blockJ];
 		if (mi >= 0) hasSprings_[mi] = 1;
 		if (mj >= 0) hasSprings_[mj] = 1;
@@ -526,7 +533,8 @@ void World::assembleOwnSystems(const IntegratorSettings& settings, double dt) {
 	ownSystems_.resize(count);
 #pragma omp parallel for schedule(static) if (count - kept >= kMinBlocksForThreads)
 	for (int k = 0; k < n; ++k)
-		if (ownSystemOf_[k] >= kept) assembleBlock(blocks_[moving_[k]], settings, dt, ownSystems_[ownSystemOf_[k]]);
+		if (ownSystemOf_[k] >= kept)
+			assembleBlock(blocks_[moving_[k]], settings, dt, startAccelerationOf(k), ownSystems_[ownSystemOf_[k]]);
 }
 
 void World::solveAloneBlocks(const IntegratorSettings& settings, double dt) {
@@ -545,7 +553,7 @@ void World::solveAloneBlocks(const IntegratorSettings& settings, double dt) {
 		if (coupled_.coupled(k) || solvedAlone_[k]) continue;
 		const Block& block = blocks_[moving_[k]];
 		BlockSystem system;
-		assembleBlock(block, settings, dt, system);
+		assembleBlock(block, settings, dt, startAccelerationOf(k), system);
 		solutions_[k] = solveBlock(block, system);
 		solvedAlone_[k] = 1;
 	}
@@ -559,7 +567,7 @@ void World::assembleContacts(StepStatistics& stats) {
 		if (!contactTerms(contact, blocks_[bi], blocks_[bj], stiffness, force)) continue;
 		// An open contact may carry its tangential spring alone (its limit is
 		// held for the pass): only closed ones have a normal spring.
-		stats.normalTerms += isClosed(contact);
+		stats.normalTerms += hasNormalTerms(contact);
 		stats.frictionTerms += tangentialTerm(contact) != TangentialTerm::None;
 		const int mi = movingIndex_[bi], mj = movingIndex_[bj];
 		if (mi >= 0) {
@@ -678,6 +686,10 @@ double World::lineSearch(const IntegratorSettings& settings, double dt) {
 		if (contact.normal.valid && searchKinks) {
 			const double g0 = line.gap, g1 = line.gap + line.gapRate;
 			kink = isClosed(contact) ? (!line.bonded && std::max(g0, g1) > 0) : std::min(g0, g1) < 0;
+			// The secant force is quadratic in energy only where the contact
+			// is closed at both ends of the step.
+			if (contact.secantWeight > 0 && !line.bonded)
+				kink = kink || (line.startGap < 0 ? std::max(g0, g1) > 0 : std::min(g0, g1) < 0);
 		}
 		if (searchKinks && !contact.slipping && line.tangential)
 			kink = kink || (line.stretch + line.stretchRate).norm() > line.limit / line.shearStiffness;
@@ -698,7 +710,7 @@ double World::lineSearch(const IntegratorSettings& settings, double dt) {
 		if (ownSystemOf_[k] >= 0)
 			system = &ownSystems_[ownSystemOf_[k]];
 		else
-			assembleBlock(blocks_[moving_[k]], settings, dt, own);
+			assembleBlock(blocks_[moving_[k]], settings, dt, startAccelerationOf(k), own);
 		groupSlope_[root[k]] += deltas_[k].dot(system->stiffness * iterate_[k] - system->force);
 		groupCurvature_[root[k]] += deltas_[k].dot(system->stiffness * deltas_[k]);
 	}
@@ -746,6 +758,22 @@ double World::lineSearch(const IntegratorSettings& settings, double dt) {
 	return smallest;
 }
 
+const Vector12& World::startAccelerationOf(int k) const {
+	static const Vector12 zero = Vector12::Zero();
+	return startAccelerations_.empty() ? zero : startAccelerations_[k];
+}
+
+void World::computeStartAccelerations(const IntegratorSettings& settings) {
+	const int n = static_cast<int>(moving_.size());
+	startAccelerations_.clear();
+	if (settings.shiScheme()) return;
+	startAccelerations_.resize(n);
+	for (int k = 0; k < n; ++k) {
+		const Block& block = blocks_[moving_[k]];
+		startAccelerations_[k] = accelerationOf(block, restForce(block, settings));
+	}
+}
+
 EnergyAccount World::energy() const {
 	EnergyAccount account = energy_;
 	account.kinetic = account.gravity = account.strain = 0;
@@ -768,6 +796,15 @@ void World::accountStep(const IntegratorSettings& settings) {
 	// potential V (sigma0 . eps + eps^T E eps / 2) (the change of the strain
 	// energy) and the Bregman divergence V/2 eps^T E eps: the damping. Point
 	// loads and fixed-point springs (end-of-step force) do the work F . u.
+	// Every member of Newmark's family with beta = gamma/2 moves the blocks
+	// by the trapezoidal rule, D = dt (v0 + v1)/2, so exactly
+	//   dKE = ((1 - gamma) F_s(0) + gamma F_s(D)) . D + G . D,
+	// F_s the blocks' own forces (a0 = M^-1 F_s(0)) and G the contacts'
+	// mean force (ContactEquations.hpp). F_s is affine in D: the elastic
+	// force's work is minus the change of the strain energy minus (2 gamma
+	// - 1) times its Bregman divergence (the damping; 0 for average
+	// acceleration), a fixed point's F(0) (1 - gamma) + F(D) gamma.
+	const double gamma = settings.newmarkGamma;
 	const int n = static_cast<int>(moving_.size());
 	for (int k = 0; k < n; ++k) {
 		const Block& block = blocks_[moving_[k]];
@@ -780,14 +817,14 @@ void World::accountStep(const IntegratorSettings& settings) {
 		}
 		if (!block.rigid) {
 			const Vector6 strain = D.segment<6>(6);
-			energy_.damping += 0.5 * block.volume * strain.dot(block.elasticity() * strain);
+			energy_.damping += (2 * gamma - 1) * 0.5 * block.volume * strain.dot(block.elasticity() * strain);
 		}
 		for (const PointLoad& load : block.loads)
 			energy_.loads += load.force.dot(displacementAt(load.position - block.centroid, D));
 		for (const FixedPoint& point : block.fixedPoints) {
 			const double stiffness = fixedPointStiffness(point, block, settings);
 			const Vector3 u = displacementAt(point.position - block.centroid, D);
-			energy_.loads += stiffness * (point.anchor - point.position - u).dot(u);
+			energy_.loads += stiffness * (point.anchor - point.position - gamma * u).dot(u);
 		}
 	}
 	// Contacts: their springs' energy at the start of this step in the
@@ -879,6 +916,7 @@ double World::step(const IntegratorSettings& settings) {
 			updateFrictionLimit(contact, true);
 			evaluateContact(contact, blocks_[bi], blocks_[bj], solutionOf(bi), solutionOf(bj));
 		}
+		computeStartAccelerations(settings);
 		// The blocks that contacts join (open ones too: their energy counts
 		// once they close) form groups whose energies are independent: each
 		// group iterates, searches and converges on its own, so a block
@@ -917,6 +955,7 @@ double World::step(const IntegratorSettings& settings) {
 				const Vector12& Di = solutionOf(bi);
 				const Vector12& Dj = solutionOf(bj);
 				const Vector3 model = tangentialForce(contact, blocks_[bi], blocks_[bj], Di, Dj);
+				const double normalMiss = normalModelError(contact, Di, Dj);
 				const bool wasClosed = isClosed(contact);
 				if (evaluateContact(contact, blocks_[bi], blocks_[bj], Di, Dj)) {
 					++group_.changes[g];
@@ -944,8 +983,9 @@ double World::step(const IntegratorSettings& settings) {
 				// so a group may slip with no normal force at all).
 				group_.largestNormalForce[g] = std::max(
 				    {group_.largestNormalForce[g], std::abs(contact.trial.normalForce), contact.slipLimit});
-				group_.forceChange[g] = std::max(
-				    group_.forceChange[g], (tangentialForce(contact, blocks_[bi], blocks_[bj], Di, Dj) - model).norm());
+				group_.forceChange[g] =
+				    std::max({group_.forceChange[g], normalMiss,
+				              (tangentialForce(contact, blocks_[bi], blocks_[bj], Di, Dj) - model).norm()});
 			}
 			// Groups whose pass converged: their limits against the normal
 			// forces found; done when they agree, else another pass. (Limits
@@ -1070,7 +1110,8 @@ double World::step(const IntegratorSettings& settings) {
 #pragma omp parallel for schedule(static) if (n >= kMinBlocksForThreads)
 	for (int k = 0; k < n; ++k) {
 		Block& block = blocks_[moving_[k]];
-		applyStep(block, solutions_[k], startVelocity(block, settings), dt);
+		applyStep(block, solutions_[k],
+		          endVelocity(solutions_[k], startVelocity(block, settings), dt));
 	}
 	stats.timeUpdate = secondsSince(phase);
 

@@ -119,6 +119,14 @@ private:
 	// changes to the account (energy_), and records the springs' energy at its
 	// end; called before the contacts and blocks are moved.
 	void accountStep(const IntegratorSettings& settings);
+	// Newmark's start acceleration a0 of each moving block (unless Shi's
+	// scheme, which does not read it): M^-1 times the forces at D = 0, its
+	// own (restForce) and its contacts' in their start states, so that the
+	// scheme starts every step from the equations of motion; none is carried
+	// from step to step (nothing to save, and new contacts count at once).
+	void computeStartAccelerations(const IntegratorSettings& settings);
+	const Vector12& startAccelerationOf(int movingIndex) const;
+	std::vector<Vector12> startAccelerations_;
 	// Moves the iterate (iterate_) towards the Newton solution (solutions_)
 	// by the step t in (0, 1] that minimises the step's energy along the way
 	// (1 unless a contact slips or crosses a kink of its energy), per group
