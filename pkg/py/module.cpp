@@ -301,6 +301,9 @@ py::dict lastStep(const SceneLink& s) {
 	d["lineSearches"] = st.lineSearches;
 	d["limitPasses"] = st.limitPasses;
 	d["limitsUnsettled"] = st.limitsUnsettled;
+	d["settleSteps"] = st.settleSteps;
+	d["settledBlocks"] = st.settledBlocks;
+	d["settleConverged"] = st.settleConverged;
 	d["openCloseCuts"] = st.openCloseCuts;
 	d["openCloseFailures"] = st.openCloseFailures;
 	d["maxPenetration"] = st.maxPenetration;
@@ -366,6 +369,7 @@ BOOST_PYTHON_MODULE(_core) {
 	    .def_readwrite("velocityRatio", &IntegratorSettings::velocityRatio)
 	    .def_readwrite("newmarkBeta", &IntegratorSettings::newmarkBeta)
 	    .def_readwrite("newmarkGamma", &IntegratorSettings::newmarkGamma)
+	    .def_readwrite("startFromRest", &IntegratorSettings::startFromRest)
 	    .def_readwrite("maxDisplacement", &IntegratorSettings::maxDisplacement)
 	    .def_readwrite("maxDisplacementRatio", &IntegratorSettings::maxDisplacementRatio)
 	    .def_readwrite("timeStepSafety", &IntegratorSettings::timeStepSafety)

@@ -141,6 +141,14 @@ class DDAIntegrator(wrapper.PyRunner):
       every such member dissipates 2 gamma - 1 times the Bregman divergence
       of the elastic and contact energies, so none creates energy; checked
       when the engine steps).
+    - ``startFromRest`` (True): before the first step, blocks at rest that
+      touch (through contacts) a fixed block or a fixed point are brought to
+      static equilibrium under gravity, loads and stresses, every touching
+      contact held by its springs with friction locked; the dynamics starts
+      from there, contacts loaded, velocities zero (``stats()['settleSteps']``,
+      ``'settledBlocks'``, ``'settleConverged'``; a scene without such an
+      equilibrium, e.g. a block on a frictionless slope, starts as placed).
+      False: start as placed, contacts unloaded.
     - ``maxDisplacement`` [m]: largest vertex displacement per step; 0 means
       ``maxDisplacementRatio`` x half the largest extent of the scene.
     - ``maxDisplacementRatio`` [-]: Shi's g2, default 0.01.
@@ -190,6 +198,8 @@ class DDAIntegrator(wrapper.PyRunner):
     newmarkBeta = _Parameter(0.5, lambda v: _finite('newmarkBeta', v, 0.25, 0.5),
                              "Newmark's beta [-]: 1/2 with gamma 1 is Shi's scheme, 1/4 with gamma 1/2 average acceleration")
     newmarkGamma = _Parameter(1.0, lambda v: _finite('newmarkGamma', v, 0.5, 1), "Newmark's gamma [-]")
+    startFromRest = _Parameter(True, lambda v: bool(v),
+                               'bring touching blocks at rest to static equilibrium before the first step')
     maxDisplacement = _Parameter(0.0, lambda v: _finite('maxDisplacement', v, 0, unit=' m'),
                                  'largest vertex displacement per step [m]; 0 = use maxDisplacementRatio')
     maxDisplacementRatio = _Parameter(0.01, lambda v: _finite('maxDisplacementRatio', v, 0, 1, lowOpen=True),
@@ -216,7 +226,7 @@ class DDAIntegrator(wrapper.PyRunner):
     reuseCandidatePairs = _Parameter(True, lambda v: bool(v),
                                      'diagnostic: reuse broad-phase candidate pairs while blocks rest (same contacts)')
 
-    _names = ('dt', 'gravity', 'velocityRatio', 'newmarkBeta', 'newmarkGamma', 'maxDisplacement', 'maxDisplacementRatio', 'timeStepGrowth',
+    _names = ('dt', 'gravity', 'velocityRatio', 'newmarkBeta', 'newmarkGamma', 'startFromRest', 'maxDisplacement', 'maxDisplacementRatio', 'timeStepGrowth',
               'maxStepCuts', 'fixedPointPenaltyFactor', 'threads', 'syncPeriod', 'contactDistance',
               'contactPenaltyFactor', 'shearStiffnessRatio', 'maxOpenCloseIterations', 'openCloseShrink',
               'collider',
@@ -257,6 +267,7 @@ def _settings(params):
     settings.gravity = params['gravity']
     settings.velocityRatio = params['velocityRatio']
     settings.newmarkBeta = params['newmarkBeta']
+    settings.startFromRest = params['startFromRest']
     settings.newmarkGamma = params['newmarkGamma']
     settings.maxDisplacement = params['maxDisplacement']
     settings.maxDisplacementRatio = params['maxDisplacementRatio']

@@ -31,8 +31,10 @@ def build(collider='MSC', engines=(), rigidTop=False):
     O.bodies.append(ddaBlock(box(4, -0.5, 0, 5, 0.5, 1), material=rough))
     O.bodies.append(ddaBlock(box(4.1, -0.4, 1, 4.9, 0.4, 1.8), material=rough, rigid=rigidTop))
     tilt = math.radians(30)
+    # As placed (startFromRest=False): the stack's contacts start unloaded and ring
+    # open and closed, so the saved state holds open, sliding and locked contacts.
     O.engines = [DDAIntegrator(dt=1e-3, gravity=(9.81 * math.sin(tilt), 0, -9.81 * math.cos(tilt)),
-                               maxDisplacement=0.01, collider=collider)] + list(engines)
+                               maxDisplacement=0.01, collider=collider, startFromRest=False)] + list(engines)
 
 
 def state():

@@ -58,6 +58,14 @@ constexpr int kLimitPasses = 12;
 // Solves of a step's iteration that take Newton's full step before the line
 // search is used regardless (see step()).
 constexpr int kFullNewtonSolves = 4;
+// Start from rest (World::settle): friction tangents are multiplied by this
+// while settling (the contacts' tangential springs hold whatever the
+// equilibrium asks), the static steps stop once one moves the blocks by no
+// more than kSettleTolerance of what the first did, and give up after
+// kSettleSteps (each closes all but about 1e-3 of the way, see settle).
+constexpr double kSettleFrictionScale = 1e6;
+constexpr double kSettleTolerance = 1e-6;
+constexpr int kSettleSteps = 12;
 double secondsSince(Clock::time_point start) {
 	return std::chrono::duration<double>(Clock::now() - start).count();
 }
@@ -470,6 +478,7 @@ void World::detectContacts(const IntegratorSettings& settings, StepStatistics& s
 				Contact& contact = store_.add(key, pair.type, sub, *blocks_[i].shape, *blocks_[j].shape);
 				contact.area = area;
 				prepareContact(contact, blocks_[i], blocks_[j], settings);
+				contact.frictionTangent *= frictionScale_;
 				stats.frictionContacts += contact.frictionTangent > 0;
 			}
 		}
@@ -844,17 +853,148 @@ void World::accountStep(const IntegratorSettings& settings) {
 
 double World::step(const IntegratorSettings& settings) {
 	validateSettings(settings);
-	const auto stepStart = Clock::now();
 	if (settings.threads > 0) omp_set_num_threads(settings.threads);
+	if (steps_ == 0 && settings.startFromRest && !settleTried_) settle(settings);
+	settleTried_ = true;
+	const double dt = advance(settings);
+	stats_.settleSteps = settleSteps_;
+	stats_.settledBlocks = settledBlocks_;
+	stats_.settleConverged = settleConverged_;
+	return dt;
+}
 
+void World::markSettlingBlocks() {
+	// Blocks joined by touching contacts (closed at D = 0: penetrating or
+	// flush, or bonded) form components; a component settles when it holds a
+	// fixed block or a fixed point and all its moving blocks are at rest.
+	const int count = blockCount();
+	std::vector<int> root(count);
+	for (int b = 0; b < count; ++b) root[b] = b;
+	auto find = [&](int b) {
+		while (root[b] != b) b = root[b] = root[root[b]];
+		return b;
+	};
+	for (const Contact& contact : store_.contacts()) {
+		if (!contact.normal.valid || contact.normal.d0 > 0) continue;
+		const int a = find(contact.key.blockI), b = find(contact.key.blockJ);
+		if (a != b) root[std::max(a, b)] = std::min(a, b);
+	}
+	std::vector<char> supported(count, 0), moving(count, 0);
+	for (int b = 0; b < count; ++b) {
+		const Block& block = blocks_[b];
+		const int r = find(b);
+		if (block.fixed || !block.fixedPoints.empty()) supported[r] = 1;
+		if (!block.fixed && !block.velocity.isZero()) moving[r] = 1;
+	}
+	frozen_.assign(count, 1);
+	settledBlocks_ = 0;
+	for (int b = 0; b < count; ++b) {
+		const int r = find(b);
+		if (blocks_[b].fixed || !supported[r] || moving[r]) continue;
+		frozen_[b] = 0;
+		++settledBlocks_;
+	}
+}
+
+void World::settle(const IntegratorSettings& settings) {
+	// Static steps bring the blocks to rest; everything a step advances is
+	// kept aside and put back, so the settling takes no time, no step and no
+	// energy of the account: it sets the scene's initial state.
+	const std::vector<Block> placed = blocks_;
+	const ContactStore placedContacts = store_;
+	const double time = time_, nextTimeStep = nextTimeStep_;
+	const long steps = steps_, misses = displacementLimitMisses_, failures = openCloseFailures_;
+	IntegratorSettings statics = settings;
+	statics.velocityRatio = 0;
+	statics.newmarkBeta = 0.5;
+	statics.newmarkGamma = 1;
+	statics.timeStepGrowth = 1;
+	// A step long enough that inertia weighs 1e-3 of the stiffest block's
+	// contact springs (2 m / dt^2 = 1e-3 kn): each static step then closes
+	// all but about 1e-3 of the distance to equilibrium.
+	double longest = settings.maxTimeStep;
+	for (const Block& block : blocks_) {
+		if (block.fixed) continue;
+		const double kn = settings.contactPenaltyFactor * block.material.young * block.size;
+		longest = std::max(longest, std::sqrt(2000 * block.mass / kn));
+	}
+	statics.maxTimeStep = longest;
+	settling_ = true;
+	frictionScale_ = kSettleFrictionScale;
+	frozen_.clear();
+	settleSteps_ = 0;
+	settleConverged_ = false;
+	double first = -1;
+	for (int k = 0; k < kSettleSteps; ++k) {
+		nextTimeStep_ = longest;
+		try {
+			advance(statics);
+		} catch (const std::exception&) {
+			// No static solution with these contacts (a system no inertia
+			// keeps definite): the scene starts as placed.
+			settleConverged_ = false;
+			++settleSteps_;
+			break;
+		}
+		++settleSteps_;
+		for (Block& block : blocks_)
+			if (!block.fixed) block.velocity.setZero();
+		const double moved = stats_.maxDisplacement;
+		if (first < 0) first = moved;
+		if (settledBlocks_ == 0) break;
+		if (moved <= kSettleTolerance * first) {
+			settleConverged_ = true;
+			break;
+		}
+	}
+	settling_ = false;
+	frictionScale_ = 1;
+	frozen_.clear();
+	if (settledBlocks_ == 0) settleSteps_ = 0;  // nothing to settle: not tried
+	if (!settleConverged_) {
+		blocks_ = placed;
+		store_ = placedContacts;
+		collider_->setPairReuse(false);  // its cache saw the moved blocks
+		settledBlocks_ = 0;
+	}
+	// The account starts here: the springs' energy is the settled state's.
+	const double springs = energy_.contact;
+	energy_ = EnergyAccount{};
+	if (settleConverged_) energy_.contact = springs;
+	time_ = time;
+	nextTimeStep_ = nextTimeStep;
+	steps_ = steps;
+	displacementLimitMisses_ = misses;
+	openCloseFailures_ = failures;
+}
+
+double World::advance(const IntegratorSettings& settings) {
+	const auto stepStart = Clock::now();
 	StepStatistics stats;
 	stats.blocks = blockCount();
+	stats.allowedDisplacement = settings.maxDisplacement > 0 ? settings.maxDisplacement
+	                                                         : settings.maxDisplacementRatio * sceneHalfSize();
+	stats.contactDistance = settings.contactDistance > 0 ? settings.contactDistance
+	                                                     : settings.contactDistanceFactor * stats.allowedDisplacement;
+	detectContacts(settings, stats);
+	if (settling_ && frozen_.empty()) markSettlingBlocks();
 	moving_.clear();
 	movingIndex_.assign(blockCount(), -1);
 	for (int i = 0; i < blockCount(); ++i) {
-		if (blocks_[i].fixed) continue;
+		if (blocks_[i].fixed || (!frozen_.empty() && frozen_[i])) continue;
 		movingIndex_[i] = static_cast<int>(moving_.size());
 		moving_.push_back(i);
+	}
+	if (settling_) {
+		// Contacts of two frozen (or fixed) blocks carry nothing while
+		// settling; left out, the first step finds them as new.
+		std::vector<Contact>& found = store_.contacts();
+		found.erase(std::remove_if(found.begin(), found.end(),
+		                           [&](const Contact& c) {
+			                           return movingIndex_[c.key.blockI] < 0 && movingIndex_[c.key.blockJ] < 0;
+		                           }),
+		            found.end());
+		stats.contacts = static_cast<int>(found.size());
 	}
 	const int n = static_cast<int>(moving_.size());
 	stats.movingBlocks = n;
@@ -869,12 +1009,6 @@ double World::step(const IntegratorSettings& settings) {
 		stats.strainUnknowns += b.unknowns() - kRigidBlockDofs;
 	}
 	solutions_.resize(n);
-
-	stats.allowedDisplacement = settings.maxDisplacement > 0 ? settings.maxDisplacement
-	                                                         : settings.maxDisplacementRatio * sceneHalfSize();
-	stats.contactDistance = settings.contactDistance > 0 ? settings.contactDistance
-	                                                     : settings.contactDistanceFactor * stats.allowedDisplacement;
-	detectContacts(settings, stats);
 	std::vector<Contact>& contacts = store_.contacts();
 
 	double dt = nextTimeStep_ > 0 ? std::min(nextTimeStep_, settings.maxTimeStep) : settings.maxTimeStep;

@@ -59,6 +59,7 @@ public:
 	void setStress(int index, const Vector6& stress);
 
 	// Advances all blocks by one accepted step; returns the dt taken [s].
+	// The first step starts from rest (settle) when settings ask for it.
 	double step(const IntegratorSettings& settings);
 	const StepStatistics& lastStep() const { return stats_; }
 	// Heap held now [bytes] (computed when asked, not every step): the broad
@@ -97,6 +98,25 @@ public:
 
 private:
 	void validateSettings(const IntegratorSettings& settings) const;
+	// One accepted step of the blocks not frozen (frozen_), as step() makes it.
+	double advance(const IntegratorSettings& settings);
+	// Start from rest (IntegratorSettings::startFromRest): static steps
+	// (Shi's static analysis: no velocity carried, inertia of a step long
+	// enough to weigh 1e-3 of a contact's stiffness) with friction locked,
+	// for the blocks at rest whose touching contacts join them to a fixed
+	// block or point (the rest frozen), until a step moves no vertex by more
+	// than kSettleTolerance of the first's; then velocities zero, the
+	// account restarted. Not converged within kSettleSteps (no equilibrium
+	// with these contacts): the scene is restored as placed.
+	void settle(const IntegratorSettings& settings);
+	// frozen_ for settling: per block, 1 unless it settles (see settle).
+	void markSettlingBlocks();
+	std::vector<char> frozen_;   // per block while settling, else empty
+	bool settling_ = false;
+	double frictionScale_ = 1;   // friction tangents x this (settling: locked)
+	bool settleTried_ = false;
+	int settleSteps_ = 0, settledBlocks_ = 0;
+	bool settleConverged_ = false;
 	// Broad and narrow phase; fills store_ with this step's sub-contacts.
 	void detectContacts(const IntegratorSettings& settings, StepStatistics& stats);
 	// The global system's structure from the contacts' trial states: only
