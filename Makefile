@@ -51,6 +51,7 @@ bench: install
 	$(PYTHON) bench/friction_startup.py
 	$(PYTHON) bench/effects.py
 	$(PYTHON) bench/energy.py
+	$(PYTHON) bench/bounce.py
 
 # Batch regressions (README, "Batch regressions"): yade-batch runs every row of a table in
 # examples/regression, each scene writes a record, check.py compares them with closed forms and

@@ -115,8 +115,8 @@ struct EnergyAccount {
 	// Energy the contacts' springs gained between the end of one step and the
 	// start of the next (D = 0 of the next step in its accepted states): new
 	// contacts found penetrating, gaps linearised again from the moved
-	// geometry, contacts that open or slide (their springs' energy lost),
-	// contacts that vanish. No formula of the scheme covers it; it is what
+	// geometry, contacts that slide (their springs' energy lost), contacts
+	// that vanish (a normal spring that opens within a step is damping). No formula of the scheme covers it; it is what
 	// contact detection and the contact states add or remove.
 	double contactChanges = 0;
 };
