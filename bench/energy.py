@@ -17,7 +17,18 @@ assert and what it costs:
   wall seconds.
 
 Writes bench/out/energy.json and prints a table. SI units.
-Run: make bench (or /usr/bin/python3 bench/energy.py [--youngs 1e5 1e11] [--time 0.6]).
+Run: make bench (or /usr/bin/python3 bench/energy.py [--youngs 1e5 1e11] [--time 0.6];
+YADE_DDA_BUILD=<build>/py to use a build tree instead of the installed package).
+
+--pile200: the issue's scene instead, the pile of
+tests/py/test_energy_and_creep.py::test_pile_of_200_cubes_never_gains_energy
+(200 cubes in 8 layers of 5 x 5, 0.2 m apart, the same seed and builder), for
+1.5 s (the top layer lands at about 1.3 s), gain and speed sampled at every
+step; writes bench/out/energy_pile200.json. Not in `make bench`: it takes many
+minutes per E (see README, *Energy of a dropped pile*). --count/--side run
+other piles of that builder (written to energy_pile<count>.json). --threads
+sets DDAIntegrator.threads (results do not depend on it; 1 is fair to other
+users of the machine).
 """
 import argparse
 import json
@@ -28,9 +39,11 @@ import time
 
 import sys
 
-import yade_dda
-from yade_dda import O, ddaBlock, DDAIntegrator, block
-from yade import wrapper
+if os.environ.get('YADE_DDA_BUILD'):  # a build tree instead of the installed package
+    sys.path.insert(0, os.environ['YADE_DDA_BUILD'])
+import yade_dda  # noqa: E402
+from yade_dda import O, ddaBlock, DDAIntegrator, block  # noqa: E402
+from yade import wrapper  # noqa: E402
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'tests', 'py'))
 from helpers import box, rotate  # noqa: E402  (the tests' shapes: same piles as test_energy_and_creep.py)
@@ -39,8 +52,8 @@ G = 9.81
 SEED = 20261125
 
 
-def run(young, duration, count=30):
-    O.reset()
+def small_pile(young, count):
+    """The 30-cube pile of `make bench` (3 x 3 per layer, 0.1 m apart)."""
     rng = random.Random(SEED)
     rock = O.materials.append(wrapper.PolyhedraMat(density=2600, young=young, poisson=0.25,
                                                    frictionAngle=math.radians(30)))
@@ -52,7 +65,20 @@ def run(young, duration, count=30):
         pts = rotate(box((x, y, z), (x + 1, y + 1, z + 1)), (rng.random(), rng.random(), rng.random()),
                      rng.uniform(-0.1, 0.1), about=(x + .5, y + .5, z + .5))
         cubes.append(O.bodies.append(ddaBlock(pts, material=rock)))
-    O.engines = [DDAIntegrator(gravity=(0, 0, -G), label='dda')]
+    return cubes
+
+
+def run(young, duration, count=30, side=None, threads=0, every=10, progress=None):
+    """side=None: the 30-cube bench pile; else the slow test's pile(count, young, SEED, side=side)."""
+    O.reset()
+    if side is None:
+        cubes = small_pile(young, count)
+    else:
+        from test_energy_and_creep import pile  # the slow test's own builder (spacing 1.2, turn 0.1)
+        cubes = pile(count, young, SEED, side=side)
+    O.engines = [DDAIntegrator(gravity=(0, 0, -G), threads=threads, label='dda')]
+
+    landed = {}  # cube: the first sampled time its fall departs from a free fall by 1%
 
     def translational():
         energy, fastest = 0.0, 0.0
@@ -62,6 +88,8 @@ def run(young, duration, count=30):
             speed2 = v[0] ** 2 + v[1] ** 2 + v[2] ** 2
             energy += blk.mass * G * blk.centroid[2] + 0.5 * blk.mass * speed2
             fastest = max(fastest, math.sqrt(speed2))
+            if b not in landed and O.time > 0 and abs(v[2] + G * O.time) > 0.01 * G * O.time:
+                landed[b] = O.time
         return energy, fastest
 
     def account(e):
@@ -74,37 +102,68 @@ def run(young, duration, count=30):
     bound = math.sqrt(2 * G * top)
     a0 = dict(yade_dda.stats()['energy'])
     gain, speed, drift, changes, steps, solves, cuts, passes, unsettled = 0.0, 0.0, 0.0, 0.0, 1, 0, 0, 0, 0
+    searches, failures, mostSolves, gainAt, speedAt = 0, 0, 0, 0.0, 0.0
+    nextReport = 0.0
     while O.time < duration:
         O.run(1, True)
         s = yade_dda.stats()
         steps += 1
         solves += s['openCloseIterationsTotal']
+        mostSolves = max(mostSolves, s['openCloseIterationsTotal'])
         cuts += s['stepCuts']
         passes += s['limitPasses']
         unsettled += s['limitsUnsettled']
-        if steps % 10:
+        searches += s['lineSearches']
+        failures = s['openCloseFailures']
+        if progress is not None and O.time >= nextReport:
+            nextReport += progress
+            print('  E %.0e t %.3f s wall %.1f s steps %d solves/step %.1f cuts %d passes %d unsettled %d gain %.2e '
+                  'speed %.3f landed %d' % (young, O.time, time.time() - start, steps, solves / steps, cuts, passes,
+                                            unsettled, gain, speed, len(landed)), flush=True)
+        if steps % every:
             continue
         e, fastest = translational()
-        gain = max(gain, (e - e0) / e0)
-        speed = max(speed, fastest / bound)
+        if (e - e0) / e0 > gain:
+            gain, gainAt = (e - e0) / e0, O.time
+        if fastest / bound > speed:
+            speed, speedAt = fastest / bound, O.time
         a = s['energy']
         scale = max(abs(a[k] - a0[k]) for k in a)
         drift = max(drift, abs(account(a) - account(a0) - (a['contactChanges'] - a0['contactChanges'])) / scale)
         changes = (a['contactChanges'] - a0['contactChanges']) / scale
-    return dict(young=young, blocks=count, time=O.time, gain=gain, speedOverFreeFall=speed, accountDrift=drift,
-                contactChanges=changes, steps=steps, solvesPerStep=solves / steps, dtCuts=cuts, limitPasses=passes,
-                limitsUnsettled=unsettled, wallSeconds=time.time() - start)
+    row = dict(young=young, blocks=count, time=O.time, gain=gain, speedOverFreeFall=speed, accountDrift=drift,
+               contactChanges=changes, steps=steps, solvesPerStep=solves / steps, dtCuts=cuts, limitPasses=passes,
+               limitsUnsettled=unsettled, wallSeconds=time.time() - start)
+    if side is not None:
+        row.update(allLandedAt=max(landed.values()) if len(landed) == len(cubes) else None, gainAt=gainAt, speedAt=speedAt, freeFallBound=bound, lineSearches=searches,
+                   openCloseFailures=failures, mostSolvesInStep=mostSolves, threads=threads)
+    return row
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--youngs', type=float, nargs='+', default=[1e5, 1e7, 1e9, 1e11])
-    parser.add_argument('--time', type=float, default=0.6)
+    parser.add_argument('--time', type=float, default=None, help='simulated seconds (0.6; 1.5 with --pile200)')
+    parser.add_argument('--pile200', action='store_true', help="the issue's 200-cube pile (slow test's scene)")
+    parser.add_argument('--count', type=int, default=None, help='cubes of the slow test\'s pile builder')
+    parser.add_argument('--side', type=int, default=5, help='cubes per layer side with --count')
+    parser.add_argument('--threads', type=int, default=0, help='DDAIntegrator.threads (0: all)')
+    parser.add_argument('--progress', type=float, default=None, help='print a line every this many simulated s')
     parser.add_argument('--out', default=os.path.join(os.path.dirname(os.path.abspath(__file__)), 'out'))
     args = parser.parse_args()
-    rows = [run(E, args.time) for E in args.youngs]
+    if args.pile200:
+        args.count, args.side = 200, 5
+    big = args.count is not None
+    duration = args.time if args.time is not None else (1.5 if big else 0.6)
+    if big:
+        rows = [run(E, duration, args.count, args.side, args.threads, every=1, progress=args.progress)
+                for E in args.youngs]
+        name = 'energy_pile%d.json' % args.count
+    else:
+        rows = [run(E, duration, threads=args.threads, progress=args.progress) for E in args.youngs]
+        name = 'energy.json'
     os.makedirs(args.out, exist_ok=True)
-    with open(os.path.join(args.out, 'energy.json'), 'w') as f:
+    with open(os.path.join(args.out, name), 'w') as f:
         json.dump(dict(seed=SEED, rows=rows), f, indent=1)
     print('%8s %9s %8s %9s %9s %6s %7s %5s %7s %6s' % ('E [Pa]', 'gain', 'speed', 'drift', 'changes', 'steps',
                                                         'solves', 'cuts', 'passes', 'wall'))
