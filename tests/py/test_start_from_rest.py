@@ -166,3 +166,32 @@ def test_energy_account_starts_at_the_settled_state(scene):
     total = lambda a: (a['kinetic'] + a['gravity'] + a['strain'] + a['contact'] + a['friction'] + a['damping']
                        - a['loads'] - a['contactChanges'])
     assert abs(total(e) - total(start)) < 1e-6 * springs + 1e-9, (e, start)
+
+
+def test_settling_never_adds_energy(scene):
+    """Each static step minimises the potential energy plus a positive inertia term
+    with D = 0 admissible, so the settled state cannot hold more energy than the
+    placed one: a stack of three deformable cubes (1, 0.8, 0.6 m) on a floor and a
+    cube on a 20 deg slope (30 deg friction), E = 1 GPa; after the first step the
+    kinetic + gravity + strain + contact energy is below its placed value (gravity
+    alone: the placed springs are unloaded, the blocks unstressed and at rest)."""
+    rock = O.materials.append(wrapper.PolyhedraMat(density=2600, young=1e9, poisson=0.25,
+                                                   frictionAngle=math.radians(30)))
+    O.bodies.append(yade_dda.ddaBlock(box((-3, -3, -1), (6, 3, 0)), material=rock, fixed=True))
+    stack, z = [], 0.0
+    for side in (1.0, 0.8, 0.6):
+        stack.append(O.bodies.append(yade_dda.ddaBlock(box((-side / 2, -side / 2, z), (side / 2, side / 2, z + side)),
+                                                       material=rock)))
+        z += side
+    geo, slab, onSlope = S.build_incline(math.radians(20), (1.0, 1.0, 1.0), 30.0, origin=(0.0, 10.0, 0.0))
+    blocks = stack + [onSlope]
+    O.engines = [DDAIntegrator(dt=1e-3, gravity=(0, 0, -G), label='dda')]
+    placed = sum(-yade_dda.block(b).mass * -G * yade_dda.block(b).centroid[2] for b in blocks)
+    O.run(1, True)
+    s = yade_dda.stats()
+    assert s['settleConverged'] and s['settledBlocks'] == 4, s
+    e = s['energy']
+    settled = e['kinetic'] + e['gravity'] + e['strain'] + e['contact']
+    print('placed', placed, 'settled', settled, 'difference', settled - placed)
+    assert settled < placed + 1e-8, (settled, placed)
+    assert e['strain'] > 0 and e['contact'] > 0   # the stack carries its weight
