@@ -187,13 +187,17 @@ def stats():
     ``lineSearches`` (solves whose step a line search shortened),
     ``limitPasses`` and ``limitsUnsettled`` (friction-limit passes after the
     first; groups of touching blocks accepted with limits still moving).
+    ``settleSteps``, ``settledBlocks``, ``settleConverged``: the start from
+    rest before the first step (DDAIntegrator's startFromRest): static steps
+    made (0: nothing to settle), blocks brought to equilibrium, and whether
+    it converged (else the scene started as placed).
     ``energy``: the energy account [J], each term from its own formula:
     ``kinetic``, ``gravity`` (potential of the last step's gravity),
     ``strain``, ``contact`` (springs of the closed contacts), and summed over
     the steps ``friction`` and ``damping`` (dissipated) and ``loads`` (work of
     point loads and fixed points); ``contactChanges`` is what the contacts'
     springs gained between steps (new penetrating contacts, gaps linearised
-    again, springs lost on opening). kinetic + gravity + strain + contact +
+    again, springs lost when contacts vanish). kinetic + gravity + strain + contact +
     friction + damping - loads - contactChanges is conserved (README,
     *Diagnostics*).
     ``memory``: heap bytes held after the detection: ``collider`` (the broad
