@@ -195,3 +195,22 @@ def test_settling_never_adds_energy(scene):
     print('placed', placed, 'settled', settled, 'difference', settled - placed)
     assert settled < placed + 1e-8, (settled, placed)
     assert e['strain'] > 0 and e['contact'] > 0   # the stack carries its weight
+
+
+@pytest.mark.parametrize('penalty', [1.0, 40.0, 4000.0])
+@pytest.mark.parametrize('rigid', [False, True], ids=['deformable', 'rigid'])
+def test_settling_converges_whatever_the_stiffness_ratio(scene, penalty, rigid):
+    """The static steps' inertia is sized by both the contacts' and the block's own
+    stiffness, so a 10 GPa cube on a 30 deg slope (20 deg friction) settles in a few
+    steps whether its contacts are 1 or 4000 times stiffer than E x size (sized by
+    the contacts alone, a deformable block at penalty 1000 did not settle in 12
+    steps: its strain modes were held back by inertia as large as their stiffness)."""
+    rock = O.materials.append(wrapper.PolyhedraMat(density=2600, young=1e10, poisson=0.25,
+                                                   frictionAngle=math.radians(20)))
+    O.bodies.append(yade_dda.ddaBlock(box((-1, -1.5, -1), (5, 1.5, 0)), material=rock, fixed=True))
+    O.bodies.append(yade_dda.ddaBlock(box((-.5, -.5, 0), (.5, .5, 1)), material=rock, rigid=rigid))
+    O.engines = [DDAIntegrator(dt=1e-4, gravity=(G * 0.5, 0, -G * math.sqrt(0.75)), contactPenaltyFactor=penalty,
+                               maxDisplacement=0.01)]
+    O.run(1, True)
+    s = yade_dda.stats()
+    assert s['settleConverged'] and s['settleSteps'] <= 6, s

@@ -909,14 +909,21 @@ void World::settle(const IntegratorSettings& settings) {
 	statics.newmarkBeta = 0.5;
 	statics.newmarkGamma = 1;
 	statics.timeStepGrowth = 1;
-	// A step long enough that inertia weighs 1e-3 of the stiffest block's
-	// contact springs (2 m / dt^2 = 1e-3 kn): each static step then closes
-	// all but about 1e-3 of the distance to equilibrium.
+	// A step long enough that inertia weighs at most 1e-3 of every block's
+	// stiffnesses: of its contact springs (2 m / dt^2 = 1e-3 kn) and, for a
+	// deformable block, of its strain modes (the mass of a uniform strain,
+	// rho J ~ rho V L^2 / 12, against V E: rho L^2 / (6 E dt^2) = 1e-3).
+	// Each static step then closes all but about 1e-3 of the distance to
+	// equilibrium. (Sized by the contacts alone, a block 1000 times stiffer
+	// in its contacts than in itself needed more than 12 steps.)
 	double longest = settings.maxTimeStep;
 	for (const Block& block : blocks_) {
 		if (block.fixed) continue;
 		const double kn = settings.contactPenaltyFactor * block.material.young * block.size;
 		longest = std::max(longest, std::sqrt(2000 * block.mass / kn));
+		if (!block.rigid)
+			longest = std::max(longest, std::sqrt(1000 * block.density() * block.size * block.size /
+			                                      (6 * block.material.young)));
 	}
 	statics.maxTimeStep = longest;
 	settling_ = true;
