@@ -598,7 +598,13 @@ def plots(result, outDir):
                 ax.plot([], [], 'o', color='C0', label='DDA')
                 ax.legend(fontsize=7, loc='best')
             ax.set_xscale('log')
-            if max(ys) / min(ys) > 20:
+            allX = xs + [p['wallPerSimulatedSecond'] for p in yade]
+            if max(allX) / min(allX) < 10:       # less than a decade: plain labels (the default overprints)
+                from matplotlib.ticker import FormatStrFormatter
+                ax.xaxis.set_major_formatter(FormatStrFormatter('%.2g'))
+                ax.xaxis.set_minor_formatter(FormatStrFormatter('%.2g'))
+            allY = ys + [max(p['error'], floor) for p in yade]     # YADE's points too, on the same axis
+            if max(allY) / min(allY) > 20:
                 ax.set_yscale('log')
             ax.set_xlabel('wall time per simulated second [s/s]', fontsize=8)
             ax.set_ylabel('error [%s]' % data['unit'], fontsize=8)
