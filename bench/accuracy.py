@@ -18,7 +18,7 @@ g = 9.81 m/s^2, simulated time tEnd = 1 s, --quick 0.3 s):
                   fixed slabs, plane friction set for a factor of safety 0.8 (limit
                   equilibrium, Hoek & Bray). Error: |s - s_exact| [m] along the keel,
                   s_exact = g sin(psi) (1 - FS) t^2/2.
-  bounce          1 m cube (E = 100 MPa, so the impact lasts about 2.5 ms) dropped flat
+  bounce          1 m cube (E = 100 MPa: rigid contact time pi sqrt(m / 4 kn) = 1.3 ms) dropped flat
                   from h = 0.05 m onto a fixed floor, no friction. Physically elastic: the
                   block rebounds with all of m g h. Error: the energy the first impact
                   dissipated over the drop energy, (E0 - E_sep) / (m g h) [-], E_sep at
