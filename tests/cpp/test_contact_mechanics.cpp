@@ -282,3 +282,34 @@ TEST(ContactMechanics, PenaltyScalesWithTheSofterBlock) {
 	EXPECT_DOUBLE_EQ(c.normalStiffness, settings.contactPenaltyFactor * 1e7 * 1.0);
 	EXPECT_DOUBLE_EQ(c.shearStiffness, settings.shearStiffnessRatio * c.normalStiffness);
 }
+
+TEST(ContactMechanics, SecantForceIsTheDiscreteGradientOfTheSpringEnergy) {
+	// The secant slope h(d) of U (normalSecant) against its definition and its
+	// derivative against finite differences, on random start and end gaps
+	// across every case (closed or apart at either end, bonded): h (d - d0) =
+	// U(d) - U(d0) exactly (the secant force's work is minus the energy's
+	// change), h' = dh/dd >= 0 and h non-decreasing in d (U convex, so the
+	// step's energy stays convex).
+	std::mt19937 rng(20261125);
+	std::uniform_real_distribution<double> gap(-1e-3, 1e-3);
+	const double kn = 4e10;
+	for (int k = 0; k < 20000; ++k) {
+		const bool bonded = k % 5 == 0;
+		const double d0 = gap(rng), d = gap(rng);
+		if (std::abs(d - d0) < 1e-6) continue;
+		const NormalSecant h = normalSecant(bonded, kn, d0, d);
+		const double change = normalSpringEnergy(bonded, kn, d) - normalSpringEnergy(bonded, kn, d0);
+		ASSERT_NEAR(h.value * (d - d0), change, 1e-12 * kn * 1e-6 + 1e-10 * std::abs(change)) << d0 << " " << d;
+		const double step = 1e-9;
+		const double fd = (normalSecant(bonded, kn, d0, d + step).value - normalSecant(bonded, kn, d0, d - step).value) /
+		                  (2 * step);
+		ASSERT_NEAR(h.slope, fd, 1e-5 * kn) << d0 << " " << d;
+		ASSERT_GE(h.slope, 0.0);
+		ASSERT_LE(h.value, normalSecant(bonded, kn, d0, d + 1e-5).value + 1e-9 * kn * 1e-5);
+	}
+	// at d = d0 the secant is the spring's own slope: no division by zero
+	const NormalSecant same = normalSecant(false, kn, -1e-4, -1e-4);
+	EXPECT_DOUBLE_EQ(same.value, -kn * 1e-4);
+	EXPECT_TRUE(std::isfinite(normalSecant(false, kn, 0.0, 1e-4).value));
+	EXPECT_TRUE(std::isfinite(normalSecant(false, kn, 1e-4, 0.0).value));
+}
