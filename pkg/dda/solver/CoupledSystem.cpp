@@ -14,7 +14,30 @@
 
 namespace dda {
 
+using SparseLLT = Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>>;
+
+struct CoupledSystem::Analysis {
+	std::vector<int> pattern;  // unknowns per slot, then each link's (lo, hi) within the component
+	std::size_t hash = 0;
+	Eigen::SparseMatrix<double> matrix;  // the pattern; its values are written by each solve
+	std::vector<int> position;           // per entry in assembly order, its index in matrix.valuePtr()
+	SparseLLT llt;                       // analysed on the pattern (empty matrix: not yet)
+	long lastBuild = 0;
+	std::size_t bytes = 0;
+};
+
+void CoupledSystem::AnalysisDeleter::operator()(Analysis* a) const { delete a; }
+
 namespace {
+
+// Patterns unused for this many builds are dropped.
+constexpr long kKeptBuilds = 16;
+
+std::size_t patternHash(const std::vector<int>& pattern) {
+	std::size_t h = 1469598103934665603ull;
+	for (int v : pattern) h = (h ^ static_cast<std::size_t>(static_cast<unsigned>(v))) * 1099511628211ull;
+	return h;
+}
 
 int findRoot(std::vector<int>& parent, int k) {
 	while (parent[k] != k) {
@@ -83,6 +106,63 @@ void CoupledSystem::build(int movingBlocks, const std::vector<std::pair<int, int
 	offDiagonal_.resize(linkSlots_.size());
 	diagonal_.resize(coupledBlocks);
 	force_.resize(coupledBlocks);
+
+	// Each sparse component's kept analysis, by its pattern (a pattern kept
+	// once serves one component per build: components solve in parallel).
+	++builds_;
+	componentAnalysis_.assign(components(), nullptr);
+	componentHash_.assign(components(), 0);
+	if (!reuse_) {
+		analyses_.clear();
+		analysisByHash_.clear();
+		return;
+	}
+	std::vector<int> pattern;
+	for (int c = 0; c < components(); ++c) {
+		const int first = componentStart_[c], last = componentStart_[c + 1];
+		if (last - first == 1) continue;
+		pattern.assign(unknowns_.begin() + first, unknowns_.begin() + last);
+		for (int l = linkStart_[c]; l < linkStart_[c + 1]; ++l) {
+			pattern.push_back(linkSlots_[l].first - first);
+			pattern.push_back(linkSlots_[l].second - first);
+		}
+		const std::size_t hash = patternHash(pattern);
+		componentHash_[c] = hash;
+		Analysis* found = nullptr;
+		for (auto [it, end] = analysisByHash_.equal_range(hash); it != end; ++it) {
+			Analysis* a = it->second;
+			if (a->lastBuild != builds_ && a->pattern == pattern) {
+				found = a;
+				// Claimed entries leave the index for this build: identical
+				// patterns (many equal clusters) are found in constant time.
+				analysisByHash_.erase(it);
+				break;
+			}
+		}
+		if (!found) {
+			analyses_.emplace_back(new Analysis);
+			found = analyses_.back().get();
+			found->pattern = pattern;
+			found->hash = hash;
+		}
+		found->lastBuild = builds_;
+		componentAnalysis_[c] = found;
+	}
+	// Drop patterns unused for kKeptBuilds builds, and the oldest unused ones
+	// while they hold more than the used ones (plus 1 MB).
+	std::size_t used = 0, unused = 0;
+	for (const AnalysisPtr& a : analyses_) (a->lastBuild == builds_ ? used : unused) += a->bytes;
+	std::stable_sort(analyses_.begin(), analyses_.end(),
+	                 [](const AnalysisPtr& a, const AnalysisPtr& b) { return a->lastBuild > b->lastBuild; });
+	while (!analyses_.empty()) {
+		const Analysis& oldest = *analyses_.back();
+		if (oldest.lastBuild == builds_) break;
+		if (oldest.lastBuild >= builds_ - kKeptBuilds && unused <= used + (std::size_t(1) << 20)) break;
+		unused -= oldest.bytes;
+		analyses_.pop_back();
+	}
+	analysisByHash_.clear();
+	for (const AnalysisPtr& a : analyses_) analysisByHash_.emplace(a->hash, a.get());
 }
 
 void CoupledSystem::reset(const std::vector<BlockSystem>& systems, const std::vector<int>& systemOf) {
@@ -112,9 +192,12 @@ int CoupledSystem::largestComponent() const {
 }
 
 std::size_t CoupledSystem::memoryBytes() const {
+	std::size_t kept = capacityBytes(analyses_) + capacityBytes(componentAnalysis_) + capacityBytes(componentHash_) +
+	                   analysisByHash_.size() * (sizeof(std::size_t) + sizeof(Analysis*) + 2 * sizeof(void*));
+	for (const AnalysisPtr& a : analyses_) kept += sizeof(Analysis) + capacityBytes(a->pattern) + a->bytes;
 	return capacityBytes(slot_) + capacityBytes(members_) + capacityBytes(unknowns_) + capacityBytes(componentStart_) +
 	       capacityBytes(diagonal_) + capacityBytes(force_) + capacityBytes(linkSlots_) + capacityBytes(linkStart_) +
-	       capacityBytes(offDiagonal_);
+	       capacityBytes(offDiagonal_) + kept;
 }
 
 void CoupledSystem::solve(std::vector<Vector12>& solutions, int threadsFrom) {
@@ -122,7 +205,8 @@ void CoupledSystem::solve(std::vector<Vector12>& solutions, int threadsFrom) {
 	bool failed = false;
 	// An integer sum, exact in any order: the count does not depend on the thread count.
 	long solved = 0;
-#pragma omp parallel for schedule(dynamic) reduction(+ : solved) if (count >= threadsFrom)
+	int reusedAnalyses = 0, newAnalyses = 0;
+#pragma omp parallel for schedule(dynamic) reduction(+ : solved, reusedAnalyses, newAnalyses) if (count >= threadsFrom)
 	for (int c = 0; c < count; ++c) {
 		const int first = componentStart_[c], last = componentStart_[c + 1];
 		if (last - first == 1) {
@@ -153,34 +237,80 @@ void CoupledSystem::solve(std::vector<Vector12>& solutions, int threadsFrom) {
 		for (int s = first; s < last; ++s) offset[s - first + 1] = offset[s - first] + unknowns_[s];
 		const int n = offset.back();
 		solved += n;
-		std::vector<Eigen::Triplet<double>> entries;
-		entries.reserve(static_cast<std::size_t>(last - first) * 78 +
-		                static_cast<std::size_t>(linkStart_[c + 1] - linkStart_[c]) * 144);
+		// The lower triangle's entries in assembly order: each diagonal
+		// block's, then each link's (the stored K[lo][hi] transposed).
+		auto forEachEntry = [&](auto&& entry) {
+			for (int s = first; s < last; ++s) {
+				const int base = offset[s - first], size = unknowns_[s];
+				for (int col = 0; col < size; ++col)
+					for (int row = col; row < size; ++row) entry(base + row, base + col, diagonal_[s](row, col));
+			}
+			for (int link = linkStart_[c]; link < linkStart_[c + 1]; ++link) {
+				const auto [lo, hi] = linkSlots_[link];
+				const int rowBase = offset[hi - first], colBase = offset[lo - first];
+				const int rows = unknowns_[hi], cols = unknowns_[lo];
+				const Matrix12& m = offDiagonal_[link];
+				for (int col = 0; col < cols; ++col)
+					for (int row = 0; row < rows; ++row) entry(rowBase + row, colBase + col, m(col, row));
+			}
+		};
+		const std::size_t entryCount = static_cast<std::size_t>(last - first) * 78 +
+		                               static_cast<std::size_t>(linkStart_[c + 1] - linkStart_[c]) * 144;
 		Eigen::VectorXd rhs(n);
-		for (int s = first; s < last; ++s) {
-			const int base = offset[s - first], size = unknowns_[s];
-			for (int col = 0; col < size; ++col)
-				for (int row = col; row < size; ++row) entries.emplace_back(base + row, base + col, diagonal_[s](row, col));
-			rhs.segment(base, size) = force_[s].head(size);
-		}
-		for (int link = linkStart_[c]; link < linkStart_[c + 1]; ++link) {
-			// Stored block is K[lo][hi]; the lower triangle holds K[hi][lo] = its transpose.
-			const auto [lo, hi] = linkSlots_[link];
-			const int rowBase = offset[hi - first], colBase = offset[lo - first];
-			const int rows = unknowns_[hi], cols = unknowns_[lo];
-			const Matrix12& m = offDiagonal_[link];
-			for (int col = 0; col < cols; ++col)
-				for (int row = 0; row < rows; ++row) entries.emplace_back(rowBase + row, colBase + col, m(col, row));
-		}
-		Eigen::SparseMatrix<double> K(n, n);
-		K.setFromTriplets(entries.begin(), entries.end());
-		Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> llt(K);
-		if (llt.info() != Eigen::Success) {
+		for (int s = first; s < last; ++s) rhs.segment(offset[s - first], unknowns_[s]) = force_[s].head(unknowns_[s]);
+		Analysis* analysis = componentAnalysis_.empty() ? nullptr : componentAnalysis_[c];
+		Eigen::VectorXd x;
+		if (!analysis) {
+			std::vector<Eigen::Triplet<double>> entries;
+			entries.reserve(entryCount);
+			forEachEntry([&](int row, int col, double value) { entries.emplace_back(row, col, value); });
+			Eigen::SparseMatrix<double> K(n, n);
+			K.setFromTriplets(entries.begin(), entries.end());
+			SparseLLT llt(K);
+			if (llt.info() != Eigen::Success) {
 #pragma omp atomic write
-			failed = true;
-			continue;
+				failed = true;
+				continue;
+			}
+			x = llt.solve(rhs);
+		} else {
+			if (analysis->matrix.rows() != n) {
+				// New pattern: the matrix setFromTriplets builds, with each
+				// entry's assembly index as its value, says where each entry goes.
+				std::vector<Eigen::Triplet<double>> entries;
+				entries.reserve(entryCount);
+				forEachEntry([&](int row, int col, double) {
+					entries.emplace_back(row, col, static_cast<double>(entries.size()));
+				});
+				analysis->matrix.resize(n, n);
+				analysis->matrix.setFromTriplets(entries.begin(), entries.end());
+				analysis->matrix.makeCompressed();
+				analysis->position.assign(entries.size(), -1);
+				const double* index = analysis->matrix.valuePtr();
+				for (Eigen::Index p = 0; p < analysis->matrix.nonZeros(); ++p)
+					analysis->position[static_cast<std::size_t>(index[p])] = static_cast<int>(p);
+				analysis->llt.analyzePattern(analysis->matrix);
+				analysis->bytes = static_cast<std::size_t>(analysis->matrix.nonZeros()) * (sizeof(double) + sizeof(int)) +
+				                  capacityBytes(analysis->position) +
+				                  static_cast<std::size_t>(analysis->llt.matrixL().nestedExpression().nonZeros()) *
+				                      (sizeof(double) + sizeof(int)) +
+				                  static_cast<std::size_t>(n) * 6 * sizeof(int);
+				++newAnalyses;
+			} else {
+				++reusedAnalyses;
+			}
+			double* values = analysis->matrix.valuePtr();
+			const int* position = analysis->position.data();
+			std::size_t e = 0;
+			forEachEntry([&](int, int, double value) { values[position[e++]] = value; });
+			analysis->llt.factorize(analysis->matrix);
+			if (analysis->llt.info() != Eigen::Success) {
+#pragma omp atomic write
+				failed = true;
+				continue;
+			}
+			x = analysis->llt.solve(rhs);
 		}
-		const Eigen::VectorXd x = llt.solve(rhs);
 		for (int s = first; s < last; ++s) {
 			const int k = members_[s], size = unknowns_[s];
 			solutions[k].setZero();
@@ -189,6 +319,8 @@ void CoupledSystem::solve(std::vector<Vector12>& solutions, int threadsFrom) {
 	}
 	if (failed) throw std::runtime_error("the DDA system is not positive definite (Cholesky failed)");
 	solvedUnknowns_ = solved;
+	reusedAnalyses_ = reusedAnalyses;
+	newAnalyses_ = newAnalyses;
 }
 
 }  // namespace dda

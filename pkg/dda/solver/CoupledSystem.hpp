@@ -17,6 +17,20 @@
 // component, ascending within one, so a component's diagonal blocks and its
 // links (sorted by slot pair) are contiguous ranges.
 //
+// Analysis reuse. A sparse component's matrix pattern (its block sizes and
+// links, numbered within the component), the map from its 12x12 blocks to
+// the compressed matrix's values and Eigen's symbolic analysis (the AMD
+// ordering and elimination tree) depend on that pattern alone: they are kept
+// per pattern and reused by every solve with the same pattern (the open-close
+// iteration's solves between structure changes, the structures it swaps
+// between, the next steps of a resting pile). The values go straight into
+// the kept matrix, each where setFromTriplets put it (a component has no
+// duplicate entries, so the matrix is the same, entry for entry), and
+// factorize() on the analysed pattern runs exactly the arithmetic of
+// compute(): the solutions are bitwise those of a fresh analysis
+// (tests/cpp/test_rigid_blocks.cpp compares them). Patterns unused for
+// kKeptBuilds builds, or beyond the used patterns' size, are dropped.
+//
 // Rigid blocks have 6 unknowns, not 12. Every block keeps the 12-layout in
 // storage (contact terms are assembled as for any block), but a rigid block's
 // strain rows and columns never enter a factorisation: alone in its
@@ -31,6 +45,8 @@
 #include "BlockEquations.hpp"
 
 #include <cstddef>
+#include <memory>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -72,7 +88,22 @@ public:
 	// Heap held [bytes] (the arrays' capacities).
 	std::size_t memoryBytes() const;
 
+	// Sparse components whose analysis was reused by the last solve, and analysed anew.
+	int reusedAnalyses() const { return reusedAnalyses_; }
+	int newAnalyses() const { return newAnalyses_; }
+	// Without reuse every solve analyses its components afresh (for tests).
+	void setAnalysisReuse(bool reuse) { reuse_ = reuse; }
+
 private:
+	struct Analysis;  // a sparse pattern's matrix, value map and analysed factorisation
+	struct AnalysisDeleter {
+		void operator()(Analysis* a) const;
+	};
+	using AnalysisPtr = std::unique_ptr<Analysis, AnalysisDeleter>;
+	// Finds (or adds) the kept analysis of component c's pattern.
+	Analysis* analysisFor(int c);
+	Analysis* analyse(int c, Analysis* kept);
+
 	std::vector<int> slot_;            // per moving block: its slot, -1 when it has no springs
 	std::vector<int> members_;         // per slot: the moving block
 	std::vector<int> unknowns_;        // per slot: 12, or 6 when rigid
@@ -85,6 +116,15 @@ private:
 	std::vector<int> linkStart_;
 	std::vector<Matrix12> offDiagonal_;  // per link
 	long solvedUnknowns_ = 0;
+	// Kept analyses, by pattern hash; per component its analysis (null for a
+	// single block, or not yet analysed).
+	std::vector<AnalysisPtr> analyses_;
+	std::unordered_multimap<std::size_t, Analysis*> analysisByHash_;
+	std::vector<Analysis*> componentAnalysis_;
+	std::vector<std::size_t> componentHash_;
+	long builds_ = 0;
+	bool reuse_ = true;
+	int reusedAnalyses_ = 0, newAnalyses_ = 0;
 };
 
 }  // namespace dda

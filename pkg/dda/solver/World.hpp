@@ -83,6 +83,10 @@ public:
 	// The broad phase (DESSCollider unless set).
 	void setCollider(std::unique_ptr<Collider> collider);
 	const Collider& collider() const { return *collider_; }
+	// Whether the coupled system keeps its sparse components' analyses
+	// between solves (on by default; the results are bitwise the same, see
+	// CoupledSystem.hpp; off for tests).
+	void setAnalysisReuse(bool reuse) { coupled_.setAnalysisReuse(reuse); }
 	// Half the largest extent of the bounding box of all blocks [m] (Shi's w0),
 	// measured at the first step after blocks were added.
 	double sceneHalfSize();
