@@ -16,12 +16,41 @@ namespace dda {
 
 using SparseLLT = Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>>;
 
+namespace {
+
+// Eigen's SimplicialLLT, analysed once and then fed its permuted matrix
+// directly. compute(K) and factorize(K) both permute K into the upper
+// triangle of P K P^T (`ordering`, and factorize's own copy, by the same
+// expression) before factorize_preordered; the permuted matrix's layout
+// depends on K's pattern and P alone, so it is built once, with each entry's
+// assembly index as its value, and each solve writes the values where those
+// indices landed: factorize_preordered then sees the very matrix factorize(K)
+// would have built.
+class KeptCholesky : public SparseLLT {
+public:
+	// Analyses the pattern of `indexed` (lower triangle, values: assembly
+	// indices; only the pattern is used) and keeps its permuted copy.
+	void analyse(const Eigen::SparseMatrix<double>& indexed) {
+		const Eigen::SparseMatrix<double>* permuted = nullptr;
+		this->ordering(indexed, permuted, permuted_);
+		this->analyzePattern_preordered(*permuted, false);
+		if (permuted != &permuted_) permuted_ = *permuted;
+	}
+	Eigen::SparseMatrix<double>& permuted() { return permuted_; }
+	void factorizePermuted() { this->template factorize_preordered<false>(permuted_); }
+
+private:
+	Eigen::SparseMatrix<double> permuted_;  // upper triangle of P K P^T
+};
+
+}  // namespace
+
 struct CoupledSystem::Analysis {
 	std::vector<int> pattern;  // unknowns per slot, then each link's (lo, hi) within the component
 	std::size_t hash = 0;
-	Eigen::SparseMatrix<double> matrix;  // the pattern; its values are written by each solve
-	std::vector<int> position;           // per entry in assembly order, its index in matrix.valuePtr()
-	SparseLLT llt;                       // analysed on the pattern (empty matrix: not yet)
+	int unknowns = 0;            // 0: not yet analysed
+	std::vector<int> position;   // per entry in assembly order, its index in the permuted matrix's values
+	KeptCholesky llt;
 	long lastBuild = 0;
 	std::size_t bytes = 0;
 };
@@ -274,23 +303,25 @@ void CoupledSystem::solve(std::vector<Vector12>& solutions, int threadsFrom) {
 			}
 			x = llt.solve(rhs);
 		} else {
-			if (analysis->matrix.rows() != n) {
+			if (analysis->unknowns != n) {
 				// New pattern: the matrix setFromTriplets builds, with each
-				// entry's assembly index as its value, says where each entry goes.
+				// entry's assembly index as its value, permuted as factorize
+				// would, says where each entry goes.
 				std::vector<Eigen::Triplet<double>> entries;
 				entries.reserve(entryCount);
 				forEachEntry([&](int row, int col, double) {
 					entries.emplace_back(row, col, static_cast<double>(entries.size()));
 				});
-				analysis->matrix.resize(n, n);
-				analysis->matrix.setFromTriplets(entries.begin(), entries.end());
-				analysis->matrix.makeCompressed();
+				Eigen::SparseMatrix<double> indexed(n, n);
+				indexed.setFromTriplets(entries.begin(), entries.end());
+				analysis->llt.analyse(indexed);
+				const Eigen::SparseMatrix<double>& permuted = analysis->llt.permuted();
 				analysis->position.assign(entries.size(), -1);
-				const double* index = analysis->matrix.valuePtr();
-				for (Eigen::Index p = 0; p < analysis->matrix.nonZeros(); ++p)
+				const double* index = permuted.valuePtr();
+				for (Eigen::Index p = 0; p < permuted.nonZeros(); ++p)
 					analysis->position[static_cast<std::size_t>(index[p])] = static_cast<int>(p);
-				analysis->llt.analyzePattern(analysis->matrix);
-				analysis->bytes = static_cast<std::size_t>(analysis->matrix.nonZeros()) * (sizeof(double) + sizeof(int)) +
+				analysis->unknowns = n;
+				analysis->bytes = static_cast<std::size_t>(permuted.nonZeros()) * (sizeof(double) + sizeof(int)) +
 				                  capacityBytes(analysis->position) +
 				                  static_cast<std::size_t>(analysis->llt.matrixL().nestedExpression().nonZeros()) *
 				                      (sizeof(double) + sizeof(int)) +
@@ -299,11 +330,11 @@ void CoupledSystem::solve(std::vector<Vector12>& solutions, int threadsFrom) {
 			} else {
 				++reusedAnalyses;
 			}
-			double* values = analysis->matrix.valuePtr();
+			double* values = analysis->llt.permuted().valuePtr();
 			const int* position = analysis->position.data();
 			std::size_t e = 0;
 			forEachEntry([&](int, int, double value) { values[position[e++]] = value; });
-			analysis->llt.factorize(analysis->matrix);
+			analysis->llt.factorizePermuted();
 			if (analysis->llt.info() != Eigen::Success) {
 #pragma omp atomic write
 				failed = true;

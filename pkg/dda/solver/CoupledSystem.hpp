@@ -24,10 +24,11 @@
 // per pattern and reused by every solve with the same pattern (the open-close
 // iteration's solves between structure changes, the structures it swaps
 // between, the next steps of a resting pile). The values go straight into
-// the kept matrix, each where setFromTriplets put it (a component has no
-// duplicate entries, so the matrix is the same, entry for entry), and
-// factorize() on the analysed pattern runs exactly the arithmetic of
-// compute(): the solutions are bitwise those of a fresh analysis
+// the permuted matrix the factorisation reads (P K P^T's upper triangle),
+// each where Eigen's permutation of setFromTriplets' matrix puts it (a
+// component has no duplicate entries, so it is the same matrix, entry for
+// entry, in the same order), and the numeric factorisation runs exactly the
+// arithmetic of compute(): the solutions are bitwise those of a fresh analysis
 // (tests/cpp/test_rigid_blocks.cpp compares them). Patterns unused for
 // kKeptBuilds builds, or beyond the used patterns' size, are dropped.
 //
