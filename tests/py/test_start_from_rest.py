@@ -214,3 +214,24 @@ def test_settling_converges_whatever_the_stiffness_ratio(scene, penalty, rigid):
     O.run(1, True)
     s = yade_dda.stats()
     assert s['settleConverged'] and s['settleSteps'] <= 6, s
+
+
+def test_blocks_in_flight_keep_their_motion_while_others_settle(scene):
+    """A cube resting on a floor settles while a cube thrown elsewhere at (2, 0, 3)
+    m/s does not: the thrown cube's flight is bitwise the one without the settling
+    (it touches nothing, so no step of the resting cube may change it), and its
+    velocity after 100 steps is v0 + g t to round-off."""
+    runs = {}
+    for start in (True, False):
+        O.reset()
+        rest = cube_on_floor(startFromRest=start)
+        rock = O.materials[0]
+        thrown = O.bodies.append(yade_dda.ddaBlock(box((10, -0.5, 5), (11, 0.5, 6)), material=rock,
+                                                   velocity=(2, 0, 3)))
+        O.run(100, True)
+        if start:
+            assert yade_dda.stats()['settledBlocks'] == 1  # the resting cube (every step reports the settling)
+        b = yade_dda.block(thrown)
+        runs[start] = tuple(b.centroid) + tuple(b.velocity)
+        assert abs(b.velocity[0] - 2) < 1e-12 and abs(b.velocity[2] - (3 - G * O.time)) < 1e-9, b.velocity
+    assert runs[True] == runs[False]

@@ -155,7 +155,8 @@ struct StepStatistics {
 	int lineSearches = 0;            // solves whose step was shortened by the line search (all attempts)
 	int limitPasses = 0;             // passes made after the first because friction limits changed (all attempts)
 	int limitsUnsettled = 0;         // attempts accepted with limits still changing after kLimitPasses passes
-	// start from rest (IntegratorSettings::startFromRest), reported by the first step
+	// start from rest (IntegratorSettings::startFromRest): the settling before the
+	// first step, in every step's report
 	int settleSteps = 0;             // static steps the settling took (0: none was tried)
 	int settledBlocks = 0;           // blocks brought to rest (0 when the settling did not converge)
 	bool settleConverged = false;    // the settling reached equilibrium (else the scene starts as placed)

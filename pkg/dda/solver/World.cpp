@@ -944,8 +944,10 @@ void World::settle(const IntegratorSettings& settings) {
 			break;
 		}
 		++settleSteps_;
-		for (Block& block : blocks_)
-			if (!block.fixed) block.velocity.setZero();
+		// The settling blocks only: a frozen one (moving, or unsupported)
+		// keeps its velocity.
+		for (int b = 0; b < blockCount(); ++b)
+			if (!blocks_[b].fixed && !frozen_[b]) blocks_[b].velocity.setZero();
 		const double moved = stats_.maxDisplacement;
 		if (first < 0) first = moved;
 		if (settledBlocks_ == 0) break;
