@@ -6,12 +6,6 @@
 
 namespace dda {
 
-double massProduct(const Block& block, const Vector12& x, const Vector12& y) {
-	if (block.rigid)
-		return x.head<6>().dot(rigidMassMatrix(block.density(), block.volume, block.secondMoment) * y.head<6>());
-	return x.dot(massMatrix(block.density(), block.volume, block.secondMoment) * y);
-}
-
 Vector12 restForce(const Block& block, const IntegratorSettings& settings) {
 	Vector12 force = Vector12::Zero();
 	if (!block.rigid) force.segment<6>(6) -= block.volume * block.stress;

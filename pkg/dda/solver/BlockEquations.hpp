@@ -47,9 +47,6 @@ inline double kineticEnergy(const Block& block, const Vector12& v) {
 	return 0.5 * v.dot(massMatrix(block.density(), block.volume, block.secondMoment) * v);
 }
 
-// x^T M y with the block's consistent mass matrix (6 x 6 for a rigid block).
-double massProduct(const Block& block, const Vector12& x, const Vector12& y);
-
 // Start-of-step velocity: the carried velocity scaled by Shi's dynamic coefficient.
 inline Vector12 startVelocity(const Block& block, const IntegratorSettings& settings) {
 	return settings.velocityRatio * block.velocity;

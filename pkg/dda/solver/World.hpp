@@ -144,10 +144,11 @@ private:
 	// end; called before the contacts and blocks are moved.
 	void accountStep(const IntegratorSettings& settings);
 	// Newmark's start acceleration a0 of each moving block (unless Shi's
-	// scheme, which does not read it): M^-1 times the forces at D = 0, its
-	// own (restForce) and its contacts' in their start states, so that the
-	// scheme starts every step from the equations of motion; none is carried
-	// from step to step (nothing to save, and new contacts count at once).
+	// scheme, which does not read it): M^-1 times the block's own forces at
+	// D = 0 (restForce). Contacts are left out: they enter as the step's mean
+	// force (ContactEquations.hpp), so a contact that opens within a step
+	// does not push with its start force over the whole step. Computed each
+	// step, not carried (nothing to save).
 	void computeStartAccelerations(const IntegratorSettings& settings);
 	const Vector12& startAccelerationOf(int movingIndex) const;
 	std::vector<Vector12> startAccelerations_;
