@@ -73,12 +73,14 @@ def test_dropped_pile_never_gains_energy(scene, young):
     """30 turned cubes dropped onto a floor, every setting at its default. Oracles:
     kinetic plus potential energy never rises above its start by more than 0.1%
     (with the hold-closed rule it rose 5-36% for 200 cubes at 1e11 Pa); no cube is
-    faster than a free fall from the top of the pile to the floor allows. At 1e11
-    Pa (strains of 1e-6) the energy account balances to 1e-3 of its largest change
-    and contact changes between steps add no energy beyond that; at 1e5 Pa the
-    cubes strain by 25% under their own weight, beyond what the account's
-    small-strain terms (V/2 sigma E^-1 sigma, the mass matrix of the strain rates)
-    book exactly, so only the first two oracles apply."""
+    faster than a free fall from the top of the pile to the floor allows; the
+    energy account balances to 1e-3 of its largest change, at 1e11 Pa (strains of
+    1e-6) and at 1e5 Pa, where the cubes strain by 25% and more under their own
+    weight (the block's finite-strain terms are exact: BlockEquations.hpp, "Finite
+    strain"). Contact changes between steps must add no energy beyond 1e-3 of the
+    largest change; at 1e5 Pa they do (0.55% by 0.6 s: the soft penalty springs
+    let the cubes overlap by 32 mm, and sub-contacts found between steps start
+    compressed), which is reported as an expected failure, not hidden."""
     print('seed', SEED)
     cubes = pile(30, young, SEED, spacing=1.1)
     O.engines = [DDAIntegrator(gravity=(0, 0, -G), label='dda')]
@@ -87,7 +89,7 @@ def test_dropped_pile_never_gains_energy(scene, young):
     top = max(yade_dda.block(b).centroid[2] for b in cubes)
     vmax = math.sqrt(2 * G * top)
     a0 = yade_dda.stats()['energy']
-    worst = 0.0
+    worst, changes = 0.0, []
     while O.time < 0.6:
         O.run(20, True)
         e, fastest = translational(cubes)
@@ -95,13 +97,16 @@ def test_dropped_pile_never_gains_energy(scene, young):
         assert fastest <= vmax, (O.time, fastest, vmax)
         a = yade_dda.stats()['energy']
         assert a['damping'] >= 0 and a['friction'] >= 0
-        if young < 1e9:
-            continue
         scale = largest(a, a0)
         drift = account(a) - account(a0) - (a['contactChanges'] - a0['contactChanges'])
         assert abs(drift) <= 1e-3 * scale, (O.time, drift, scale)
-        assert a['contactChanges'] - a0['contactChanges'] <= 1e-3 * scale, (O.time, a)
+        changes.append(((a['contactChanges'] - a0['contactChanges']) / scale, O.time))
     assert worst <= 1e-3, worst
+    share, when = max(changes)
+    if share > 1e-3 and young < 1e9:
+        pytest.xfail('contact changes between steps added %.2g of the largest change by t = %.2f s (soft '
+                     'penalty, deep overlaps; see the docstring)' % (share, when))
+    assert share <= 1e-3, (share, when)
 
 
 @pytest.mark.slow
@@ -419,3 +424,35 @@ def test_issue_wedge_below_fs_one_slides_as_coulomb_says(scene, dt):
     assert abs(along - expected) < 5e-3 * expected
     assert abs((v2 - v1) - acc * 0.5) < 5e-4 * acc * 0.5
     assert across < 1e-3 * expected
+
+
+@pytest.mark.parametrize('scheme', [(0.5, 1.0), (0.25, 0.5)])
+def test_energy_account_is_exact_for_a_block_vibrating_at_finite_strain(scene, scheme):
+    """A free deformable block released from a random initial stress up to 0.3 E
+    (strains of 30%, volume swinging by 15-20%) and spun at a random rate, no
+    gravity and no contacts, 1000 steps under Shi's scheme and under average
+    acceleration. Oracle: the account's sum (kinetic + strain + damping) stays its
+    start value to 1e-10 of the largest term: the step changes the strain energy
+    V0/2 tau E^-1 tau by exactly the elastic work, and the rates' kinetic energy
+    carries over to the moved block exactly (BlockEquations.hpp, "Finite strain").
+    Before, the account drifted by up to 44% of the strain energy here."""
+    rng = random.Random(SEED + 17)
+    print('seed', SEED + 17)
+    mat = O.materials.append(wrapper.PolyhedraMat(density=1000, young=1e6, poisson=0.3))
+    stress = [rng.uniform(-3e5, 3e5) for _ in range(6)]
+    pts = rotate(box((0, 0, 0), (1, 0.7, 0.5)), (rng.random(), rng.random(), rng.random()), rng.uniform(0, 3))
+    b = O.bodies.append(yade_dda.ddaBlock(pts, material=mat, stress=stress))
+    yade_dda.setVelocity(b, (0, 0, 0), [rng.uniform(-3, 3) for _ in range(3)])
+    beta, gamma = scheme
+    O.engines = [DDAIntegrator(gravity=(0, 0, 0), dt=1e-3, newmarkBeta=beta, newmarkGamma=gamma)]
+    O.step()
+    a0 = yade_dda.stats()['energy']
+    volumes, biggest, worst = [], 0.0, 0.0
+    for _ in range(1000):
+        O.step()
+        a = yade_dda.stats()['energy']
+        volumes.append(yade_dda.block(b).volume)
+        biggest = max(biggest, a['strain'], a['kinetic'])
+        worst = max(worst, abs(account(a) - account(a0)))
+    assert max(volumes) - min(volumes) > 0.1 * 0.35, (min(volumes), max(volumes))  # finite strain indeed
+    assert worst <= 1e-10 * biggest, (worst, biggest)

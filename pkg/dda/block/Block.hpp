@@ -75,6 +75,10 @@ struct Block {
 	double unsyncedStrain = 0;
 
 	double density() const { return mass / volume; }  // current [kg/m^3]
+	// Volume at creation [m^3] (the mass is conserved and the material's
+	// density is the density at creation): the measure of the stored strain
+	// energy and the elastic stiffness (BlockEquations.hpp, "Finite strain").
+	double referenceVolume() const { return mass / material.density; }
 	// Characteristic length: cube root of the volume at creation [m].
 	double size = 0;
 };

@@ -57,7 +57,7 @@ void assembleBlock(const Block& block, const IntegratorSettings& settings, doubl
 	const Matrix12 mass = massMatrix(block.density(), block.volume, block.secondMoment);
 	addInertia(mass, v0, a0, settings, dt, system.stiffness, system.force);
 
-	system.stiffness.block<6, 6>(6, 6).noalias() += block.volume * block.elasticity();
+	system.stiffness.block<6, 6>(6, 6).noalias() += block.referenceVolume() * block.elasticity();
 	system.force.segment<6>(6).noalias() -= block.volume * block.stress;
 
 	if (!settings.gravity.isZero()) system.force.head<3>() += block.mass * settings.gravity;
@@ -140,10 +140,33 @@ BlockMotion blockMotion(const Block& block, const Vector12& D) {
 	BlockMotion motion;
 	motion.rotation = rotationFromVector(D.segment<3>(3));
 	motion.deformation =
-	    block.rigid ? motion.rotation : Matrix3((Matrix3::Identity() + strainTensor(D.segment<6>(6))) * motion.rotation);
+	    block.rigid ? motion.rotation : Matrix3(motion.rotation * (Matrix3::Identity() + strainTensor(D.segment<6>(6))));
 	motion.oldCentroid = block.centroid;
 	motion.newCentroid = block.centroid + D.head<3>();
 	return motion;
+}
+
+Vector12 transportedRates(const Vector12& velocity, const Matrix3& rotation, const Matrix3& stretch) {
+	// Within a step the block's points move as x = c + A(t) y, y their
+	// offsets at the step's start, A = I + [r]x + S linear in the unknowns,
+	// so the rates' kinetic energy 1/2 tr(A' J A'^T) (J the mass-weighted
+	// second moments at the start) is the step's mass matrix exactly. The
+	// accepted step maps y to y' = R U y (U = I + S); the velocity gradient
+	// L' = R A' U^-1 R^T at the new offsets y' gives
+	//   tr(L' J' L'^T) = tr(R A' U^-1 R^T R U J U^T R^T R U^-T A'^T R^T) = tr(A' J A'^T),
+	// J' = R U J U^T R^T the new second moments: the kinetic energy carries
+	// over exactly. Without strain (U = I) it turns the spin and strain rates
+	// with the block (a spin about a fixed axis is unchanged).
+	Matrix3 rate = strainTensor(velocity.segment<6>(6));
+	const Vector3 w = velocity.segment<3>(3);
+	rate(0, 1) -= w.z(); rate(1, 0) += w.z();
+	rate(0, 2) += w.y(); rate(2, 0) -= w.y();
+	rate(1, 2) -= w.x(); rate(2, 1) += w.x();
+	const Matrix3 L = rotation * stretch.transpose().partialPivLu().solve(rate.transpose()).transpose() * rotation.transpose();
+	Vector12 carried = velocity;
+	carried.segment<3>(3) = 0.5 * Vector3(L(2, 1) - L(1, 2), L(0, 2) - L(2, 0), L(1, 0) - L(0, 1));
+	carried.segment<6>(6) = strainVoigt(0.5 * (L + L.transpose()));
+	return carried;
 }
 
 void applyStep(Block& block, const Vector12& D, const Vector12& velocity) {
@@ -160,28 +183,34 @@ void applyStep(Block& block, const Vector12& D, const Vector12& velocity) {
 
 	if (block.rigid) {
 		// Rigid motion: the volume is unchanged (det R = 1 up to round-off,
-		// which is not applied), the second moments turn with the block;
-		// stress, strain and strain rates stay exactly zero.
+		// which is not applied), the second moments turn with the block, and
+		// so does its angular velocity (transportedRates); stress, strain and
+		// strain rates stay exactly zero.
 		block.secondMoment = rotation * block.secondMoment * rotation.transpose();
-		block.velocity.head<6>() = velocity.head<6>();
+		block.velocity.head<3>() = velocity.head<3>();
+		block.velocity.segment<3>(3) = rotation * velocity.segment<3>(3);
 		block.velocity.tail<6>().setZero();
 		return;
 	}
 
 	// An affine map x -> c' + L (x - c) maps the centroid to c' and scales
 	// volume by det L; the second moments transform as det(L) L J L^T (exact).
+	const double startVolume = block.volume;
 	const double jacobian = deformation.determinant();
 	block.volume *= jacobian;
 	block.secondMoment = jacobian * deformation * block.secondMoment * deformation.transpose();
 
-	// End velocity of the step; tensors follow the block's rotation.
-	block.velocity = velocity;
-	const Matrix3 strainRate = rotation * strainTensor(velocity.segment<6>(6)) * rotation.transpose();
-	block.velocity.segment<6>(6) = strainVoigt(strainRate);
+	// End velocity of the step, carried to the block's new configuration.
+	block.velocity = transportedRates(velocity, rotation, Matrix3::Identity() + strainTensor(D.segment<6>(6)));
 
+	// Kirchhoff stress tau = (V / V0) sigma: tau1 = R (tau0 + E eps) R^T
+	// ("Finite strain" in BlockEquations.hpp); the state keeps sigma1 = (V0 /
+	// V1) tau1. The strain increment is added in the start frame, then turned.
 	const Vector6 strainIncrement = D.segment<6>(6);
-	block.stress = stressVoigt(rotation * stressTensor(block.stress) * rotation.transpose()) + block.elasticity() * strainIncrement;
-	block.strain = strainVoigt(rotation * strainTensor(block.strain) * rotation.transpose()) + strainIncrement;
+	const double referenceVolume = block.referenceVolume();
+	const Vector6 kirchhoff = (startVolume / referenceVolume) * block.stress + block.elasticity() * strainIncrement;
+	block.stress = (referenceVolume / block.volume) * stressVoigt(rotation * stressTensor(kirchhoff) * rotation.transpose());
+	block.strain = strainVoigt(rotation * strainTensor(block.strain + strainIncrement) * rotation.transpose());
 	block.unsyncedStrain += strainIncrement.norm();
 }
 

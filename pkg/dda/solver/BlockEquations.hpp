@@ -11,7 +11,7 @@
 // 1/2, gamma = 1 (a constant acceleration over the step): (2/dt^2) M D =
 // (2/dt) M v0 + F(D), v1 = 2 D / dt - v0, and a0 drops out. Further terms of
 // F, each the derivative of a potential energy with respect to D:
-//   elastic strain energy     V/2 eps^T E eps        -> K_ee += V E
+//   elastic strain energy     V0/2 eps^T E eps       -> K_ee += V0 E
 //   stress of the last step   V sigma^T eps          -> F_e  -= V sigma
 //   gravity                   -m g . t               -> F_t  += m g
 //   fixed point (penalty k)   k/2 |x + T(x)D - a|^2  -> K += k T^T T, F += k T^T (a - x)
@@ -19,6 +19,25 @@
 // Shi's scheme is exact for a constant acceleration (free fall) and, being
 // Newmark with gamma = 1, dissipates high frequencies: it never creates
 // energy. Average acceleration (1/4, 1/2) keeps a linear system's energy.
+//
+// Finite strain. A block's state carries the Cauchy stress sigma and its
+// volume V; V0 = Block::referenceVolume() is its volume at creation and
+// tau = (V / V0) sigma its Kirchhoff stress. The step's strain unknowns eps
+// are a strain increment in the block's start frame; the step moves a point
+// by x -> c' + R (I + eps)(x - c) (strain, then the exact rotation R), and
+// the stress follows
+//   tau1 = R (tau0 + E eps) R^T,
+// an increment of E eps per unit reference volume (Hencky's law for
+// increments: summed over many steps eps is the logarithmic strain). The
+// strain energy is the state function W = V0/2 tau^T E^-1 tau (E isotropic,
+// so turning tau leaves W unchanged), and the step's elastic force
+// -V0 (tau0 + E eps) = -(V sigma0 + V0 E eps) is exactly -dW/d(eps): the
+// stored energy changes by exactly the work of the step's elastic force
+// (no energy from nowhere, however large the strain). Earlier versions used
+// V E and sigma1 = R sigma0 R^T + E eps: the elastic force V sigma then falls
+// as a compressed block's volume shrinks (it peaks near a strain of -1), so a
+// heavily loaded soft block had no equilibrium and was crushed flat, and the
+// account drifted by (V1 - V0)/2 sigma1^T E^-1 sigma1 each step.
 #pragma once
 
 #include "IntegratorSettings.hpp"
@@ -94,17 +113,24 @@ double largestVertexDisplacement(const Block& block, const Vector12& D);
 // move by it.
 struct BlockMotion {
 	Vector3 oldCentroid, newCentroid;
-	Matrix3 rotation, deformation;  // R and (I + S) R
+	Matrix3 rotation, deformation;  // R and R (I + S)
 	Vector3 operator()(const Vector3& x) const { return newCentroid + deformation * (x - oldCentroid); }
 };
 BlockMotion blockMotion(const Block& block, const Vector12& D);
 
-// Applies an accepted step: exact rotation about the centroid, then the strain,
-// to vertices, supports, loads and mass properties; new velocity; stress update
-// (the old stress rotated with the block plus E times the strain increment).
+// Applies an accepted step: the strain in the block's start frame, then the
+// exact rotation about the centroid, to vertices, supports, loads and mass
+// properties; new velocity; stress update (see "Finite strain" above).
 // A rigid block: rotation and translation only; volume kept, second moments
 // turned (R J R^T), stress, strain and strain rates left exactly zero.
 // `velocity` is the end velocity (endVelocity) in the start configuration.
 void applyStep(Block& block, const Vector12& D, const Vector12& velocity);
+
+// A deformable block's rates (velocity: translation, spin, strain rates in the
+// step's start frame) carried through the step's stretch U = I + S and
+// rotation R to the new configuration so that their kinetic energy is
+// unchanged (the proof is at the definition). A rigid block's spin is turned
+// by R, the same rule with U = I.
+Vector12 transportedRates(const Vector12& velocity, const Matrix3& rotation, const Matrix3& stretch);
 
 }  // namespace dda

@@ -791,7 +791,9 @@ EnergyAccount World::energy() const {
 		account.gravity -= block.mass * gravity_.dot(block.centroid);
 		account.kinetic += kineticEnergy(block, block.velocity);
 		if (!block.rigid && !block.stress.isZero())
-			account.strain += 0.5 * block.volume * block.stress.dot(block.elasticity().ldlt().solve(block.stress));
+			// W = V0/2 tau^T E^-1 tau, tau = (V / V0) sigma (BlockEquations.hpp).
+			account.strain += 0.5 * (block.volume * block.volume / block.referenceVolume()) *
+			                  block.stress.dot(block.elasticity().ldlt().solve(block.stress));
 	}
 	return account;
 }
@@ -801,9 +803,10 @@ void World::accountStep(const IntegratorSettings& settings) {
 	// gives 1/2 v1^T M v1 - 1/2 v0^T M v0 = F(D) . D exactly: the kinetic
 	// energy changes by the work of the end-of-step forces over D. Gravity's
 	// work is minus the change of its potential exactly (the centroid moves
-	// by D's translation). The elastic force -V (sigma0 + E eps) has the
-	// potential V (sigma0 . eps + eps^T E eps / 2) (the change of the strain
-	// energy) and the Bregman divergence V/2 eps^T E eps: the damping. Point
+	// by D's translation). The elastic force -V0 (tau0 + E eps) has the
+	// potential V0 (tau0 . eps + eps^T E eps / 2) (the change of the strain
+	// energy, at any strain: BlockEquations.hpp, "Finite strain") and the
+	// Bregman divergence V0/2 eps^T E eps: the damping. Point
 	// loads and fixed-point springs (end-of-step force) do the work F . u.
 	// Every member of Newmark's family with beta = gamma/2 moves the blocks
 	// by the trapezoidal rule, D = dt (v0 + v1)/2, so exactly
@@ -826,7 +829,7 @@ void World::accountStep(const IntegratorSettings& settings) {
 		}
 		if (!block.rigid) {
 			const Vector6 strain = D.segment<6>(6);
-			energy_.damping += (2 * gamma - 1) * 0.5 * block.volume * strain.dot(block.elasticity() * strain);
+			energy_.damping += (2 * gamma - 1) * 0.5 * block.referenceVolume() * strain.dot(block.elasticity() * strain);
 		}
 		for (const PointLoad& load : block.loads)
 			energy_.loads += load.force.dot(displacementAt(load.position - block.centroid, D));
