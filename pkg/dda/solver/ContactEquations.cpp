@@ -203,20 +203,6 @@ Vector3 tangentialForce(const Contact& contact, const Block& blockI, const Block
 	return -(contact.slipLimit * contact.stretch / stretch + slipStiffness(contact) * (s - contact.stretch));
 }
 
-double ContactLine::derivative(double t) const {
-	const double gapAt = gap + t * gapRate;
-	double value = normalStiffness * (bonded ? gapAt : std::min(0.0, gapAt)) * gapRate;
-	if (tangential) {
-		const Vector3 s = stretch + t * stretchRate;
-		const double norm = s.norm();
-		if (shearStiffness * norm <= limit)
-			value += shearStiffness * s.dot(stretchRate);
-		else
-			value += limit * s.dot(stretchRate) / norm;
-	}
-	return value;
-}
-
 ContactLine contactLine(const Contact& contact, const Block& blockI, const Block& blockJ, const Vector12& Di,
                         const Vector12& Dj, const Vector12& deltaI, const Vector12& deltaJ) {
 	ContactLine line;

@@ -58,6 +58,8 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
+
 namespace dda {
 
 using Vector24 = Eigen::Matrix<double, 24, 1>;
@@ -116,7 +118,20 @@ struct ContactLine {
 	double limit = 0;      // L [N]; 0: no tangential force
 	bool bonded = false;   // holds tension
 	bool tangential = false;
-	double derivative(double t) const;
+	// Inline: the line search sums it over a group's lines some 40 times a solve.
+	double derivative(double t) const {
+		const double gapAt = gap + t * gapRate;
+		double value = normalStiffness * (bonded ? gapAt : std::min(0.0, gapAt)) * gapRate;
+		if (tangential) {
+			const Vector3 s = stretch + t * stretchRate;
+			const double norm = s.norm();
+			if (shearStiffness * norm <= limit)
+				value += shearStiffness * s.dot(stretchRate);
+			else
+				value += limit * s.dot(stretchRate) / norm;
+		}
+		return value;
+	}
 };
 ContactLine contactLine(const Contact& contact, const Block& blockI, const Block& blockJ, const Vector12& Di,
                         const Vector12& Dj, const Vector12& deltaI, const Vector12& deltaJ);

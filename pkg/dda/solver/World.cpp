@@ -488,7 +488,7 @@ World::MemoryUse World::memoryUse() const {
 	             capacityBytes(ownSystemOf_) + capacityBytes(solvedAlone_) + capacityBytes(links_) +
 	             capacityBytes(hasSprings_) + capacityBytes(blockUnknowns_) + capacityBytes(iterate_) +
 	             capacityBytes(deltas_) + capacityBytes(lines_) + capacityBytes(groupRoot_) + capacityBytes(lineGroup_) +
-	             capacityBytes(groupLines_) + capacityBytes(lineOrder_) + capacityBytes(groupKink_) +
+	             capacityBytes(groupLines_) + capacityBytes(orderedLines_) + capacityBytes(groupKink_) +
 	             capacityBytes(groupSlope_) + capacityBytes(groupCurvature_) + capacityBytes(groupStep_) +
 	             capacityBytes(contactGroup_) + group_.memoryBytes();
 	return use;
@@ -704,23 +704,26 @@ double World::lineSearch(const IntegratorSettings& settings, double dt) {
 	}
 	// The lines of each searched group, together (a counting sort by group).
 	groupStep_.assign(n, 1.0);
-	lineOrder_.clear();
 	groupLines_.assign(n + 1, 0);
 	for (std::size_t c = 0; c < lines_.size(); ++c)
 		if (groupKink_[lineGroup_[c]]) ++groupLines_[lineGroup_[c] + 1];
 	for (int g = 0; g < n; ++g) groupLines_[g + 1] += groupLines_[g];
-	lineOrder_.resize(groupLines_[n]);
+	// Copied in that order, so the bisection reads each group's lines
+	// contiguously (and sums them in the same order as before).
+	orderedLines_.resize(groupLines_[n]);
 	{
 		std::vector<int> next(groupLines_.begin(), groupLines_.end() - 1);
 		for (std::size_t c = 0; c < lines_.size(); ++c)
-			if (groupKink_[lineGroup_[c]]) lineOrder_[next[lineGroup_[c]]++] = static_cast<int>(c);
+			if (groupKink_[lineGroup_[c]]) orderedLines_[next[lineGroup_[c]]++] = lines_[c];
 	}
 	double smallest = 1;
 	for (int g = 0; g < n; ++g) {
 		if (!groupKink_[g] || group_.done[g]) continue;
 		auto derivative = [&](double at) {
 			double value = groupSlope_[g] + at * groupCurvature_[g];
-			for (int c = groupLines_[g]; c < groupLines_[g + 1]; ++c) value += lines_[lineOrder_[c]].derivative(at);
+			const ContactLine* line = orderedLines_.data() + groupLines_[g];
+			const ContactLine* end = orderedLines_.data() + groupLines_[g + 1];
+			for (; line != end; ++line) value += line->derivative(at);
 			return value;
 		};
 		if (!(derivative(1) > 0)) continue;

@@ -202,8 +202,8 @@ private:
 	std::vector<Vector12> solutions_;  // the last Newton solution, per moving block
 	std::vector<Vector12> iterate_;    // the current iterate of the step's iteration
 	std::vector<Vector12> deltas_;     // lineSearch's work arrays
-	std::vector<ContactLine> lines_;
-	std::vector<int> groupRoot_, lineGroup_, groupLines_, lineOrder_;
+	std::vector<ContactLine> lines_, orderedLines_;  // per contact; the searched groups' lines, group by group
+	std::vector<int> groupRoot_, lineGroup_, groupLines_;
 	std::vector<char> groupKink_;
 	std::vector<double> groupSlope_, groupCurvature_, groupStep_;
 	// This attempt's own systems of the blocks coupled at some build
