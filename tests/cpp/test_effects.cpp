@@ -4,7 +4,8 @@
 // stack); fixed-fixed pairs never searched and MSC shells of fixed blocks
 // built once; no friction terms without friction, no body force without
 // gravity, static analysis (velocityRatio = 0); no stored system for blocks
-// without springs; sparse analyses kept between solves. Counters, not timings.
+// without springs; sparse analyses and contact terms kept between solves.
+// Counters, not timings.
 #include "dda/collider/Collider.hpp"
 #include "dda/collider/MSCCollider.hpp"
 #include "dda/solver/CoupledSystem.hpp"
@@ -359,13 +360,15 @@ TEST(Effects, SparseAnalysisReuseGivesBitwiseTheFreshSolutions) {
 }
 
 // The same on a settling pile: every step bitwise the same with and without
-// the kept analyses (vertices, velocities and the iteration's counts).
-TEST(Effects, SparseAnalysisReuseLeavesAPileBitwiseTheSame) {
+// the work the solver keeps between solves (the sparse analyses, and the
+// terms of contacts that do not slip): vertices, velocities and the
+// iteration's counts.
+TEST(Effects, SolverReuseLeavesAPileBitwiseTheSame) {
 	World reused = pile(std::make_unique<DESSCollider>(), 5, 0.3);
 	World fresh = pile(std::make_unique<DESSCollider>(), 5, 0.3);
-	fresh.setAnalysisReuse(false);
+	fresh.setSolverReuse(false);
 	IntegratorSettings settings = gravitySettings(true);
-	int coupledSteps = 0;
+	int coupledSteps = 0, laterSolves = 0;
 	for (int step = 0; step < 300; ++step) {
 		reused.step(settings);
 		fresh.step(settings);
@@ -373,6 +376,7 @@ TEST(Effects, SparseAnalysisReuseLeavesAPileBitwiseTheSame) {
 		ASSERT_EQ(a.openCloseIterationsTotal, b.openCloseIterationsTotal) << "step " << step;
 		ASSERT_EQ(a.stepCuts, b.stepCuts) << "step " << step;
 		coupledSteps += a.largestComponent > 1;
+		laterSolves += a.openCloseIterationsTotal - (a.stepCuts + 1);
 		for (int k = 0; k < reused.blockCount(); ++k) {
 			ASSERT_EQ(reused.block(k).velocity, fresh.block(k).velocity) << "step " << step << " block " << k;
 			for (std::size_t v = 0; v < reused.block(k).vertices.size(); ++v)
@@ -380,4 +384,6 @@ TEST(Effects, SparseAnalysisReuseLeavesAPileBitwiseTheSame) {
 		}
 	}
 	EXPECT_GT(coupledSteps, 100);  // the sparse path was taken
+	EXPECT_GT(laterSolves, 100);   // solves after an attempt's first, which add kept terms
+	EXPECT_GT(reused.memoryUse().solver, fresh.memoryUse().solver);  // terms and analyses were kept
 }

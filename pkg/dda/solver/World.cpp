@@ -58,6 +58,9 @@ constexpr int kLimitPasses = 12;
 // Solves of a step's iteration that take Newton's full step before the line
 // search is used regardless (see step()).
 constexpr int kFullNewtonSolves = 4;
+// Heap for the contact terms kept within an attempt (World::keptTerms_):
+// about 3,400 contacts; the others' terms are made at every solve.
+constexpr std::size_t kKeptTermsBytes = std::size_t(16) << 20;
 double secondsSince(Clock::time_point start) {
 	return std::chrono::duration<double>(Clock::now() - start).count();
 }
@@ -488,7 +491,8 @@ World::MemoryUse World::memoryUse() const {
 	             capacityBytes(ownSystemOf_) + capacityBytes(solvedAlone_) + capacityBytes(links_) +
 	             capacityBytes(hasSprings_) + capacityBytes(blockUnknowns_) + capacityBytes(iterate_) +
 	             capacityBytes(deltas_) + capacityBytes(lines_) + capacityBytes(groupRoot_) + capacityBytes(lineGroup_) +
-	             capacityBytes(groupLines_) + capacityBytes(orderedLines_) + capacityBytes(groupKink_) +
+	             capacityBytes(groupLines_) + capacityBytes(orderedLines_) + capacityBytes(keptTerms_) +
+	             capacityBytes(keptTermsOf_) + capacityBytes(keptTermsKey_) + capacityBytes(groupKink_) +
 	             capacityBytes(groupSlope_) + capacityBytes(groupCurvature_) + capacityBytes(groupStep_) +
 	             capacityBytes(contactGroup_) + group_.memoryBytes();
 	return use;
@@ -552,15 +556,51 @@ void World::solveAloneBlocks(const IntegratorSettings& settings, double dt) {
 }
 
 void World::assembleContacts(StepStatistics& stats) {
-	Matrix24 stiffness;
-	Vector24 force;
-	for (const Contact& contact : store_.contacts()) {
+	Matrix24 stiffnessWork;
+	Vector24 forceWork;
+	const std::vector<Contact>& contacts = store_.contacts();
+	keptTermsOf_.resize(contacts.size(), -1);
+	keptTermsKey_.resize(contacts.size(), 0);
+	for (std::size_t c = 0; c < contacts.size(); ++c) {
+		const Contact& contact = contacts[c];
 		const int bi = contact.key.blockI, bj = contact.key.blockJ;
-		if (!contactTerms(contact, blocks_[bi], blocks_[bj], stiffness, force)) continue;
+		const bool closed = isClosed(contact);
+		const TangentialTerm tangential = tangentialTerm(contact);
+		// No terms (what contactTerms returns false for).
+		if (!closed && tangential == TangentialTerm::None) continue;
+		// Kept terms while the state is the one they were made for (a
+		// slipping contact's depend on its stretch: always made anew).
+		const unsigned char key = static_cast<unsigned char>(1 + closed + 2 * static_cast<int>(tangential));
+		const Matrix24* stiffnessOf = &stiffnessWork;
+		const Vector24* forceOf = &forceWork;
+		const int kept = keptTermsOf_[c];
+		if (tangential != TangentialTerm::FrictionLoad && kept >= 0 && keptTermsKey_[c] == key) {
+			stiffnessOf = &keptTerms_[kept].stiffness;
+			forceOf = &keptTerms_[kept].force;
+		} else {
+			contactTerms(contact, blocks_[bi], blocks_[bj], stiffnessWork, forceWork);
+			if (keepTerms_ && tangential != TangentialTerm::FrictionLoad &&
+			    (kept >= 0 || (keptTerms_.size() + 1) * sizeof(KeptTerms) <= kKeptTermsBytes)) {
+				if (kept < 0) {
+					// Grown by hand so that its capacity stays within the budget.
+					if (keptTerms_.size() == keptTerms_.capacity())
+						keptTerms_.reserve(std::min(std::max<std::size_t>(64, 2 * keptTerms_.capacity()),
+						                            kKeptTermsBytes / sizeof(KeptTerms)));
+					keptTermsOf_[c] = static_cast<int>(keptTerms_.size());
+					keptTerms_.emplace_back();
+				}
+				KeptTerms& entry = keptTerms_[keptTermsOf_[c]];
+				entry.stiffness = stiffnessWork;
+				entry.force = forceWork;
+				keptTermsKey_[c] = key;
+			}
+		}
+		const Matrix24& stiffness = *stiffnessOf;
+		const Vector24& force = *forceOf;
 		// An open contact may carry its tangential spring alone (its limit is
 		// held for the pass): only closed ones have a normal spring.
-		stats.normalTerms += isClosed(contact);
-		stats.frictionTerms += tangentialTerm(contact) != TangentialTerm::None;
+		stats.normalTerms += closed;
+		stats.frictionTerms += tangential != TangentialTerm::None;
 		const int mi = movingIndex_[bi], mj = movingIndex_[bj];
 		if (mi >= 0) {
 			coupled_.diagonal(mi) += stiffness.topLeftCorner<12, 12>();
@@ -872,6 +912,8 @@ double World::step(const IntegratorSettings& settings) {
 		// friction-switch rules this replaces held contacts in tension and
 		// created energy (a stiff pile gained up to 36%).
 		iterate_.assign(n, Vector12::Zero());
+		keptTerms_.clear();
+		keptTermsOf_.assign(contacts.size(), -1);
 		for (Contact& contact : contacts) {
 			startTrial(contact, steps_ == 0);
 			const int bi = contact.key.blockI, bj = contact.key.blockJ;

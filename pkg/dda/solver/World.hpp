@@ -83,10 +83,14 @@ public:
 	// The broad phase (DESSCollider unless set).
 	void setCollider(std::unique_ptr<Collider> collider);
 	const Collider& collider() const { return *collider_; }
-	// Whether the coupled system keeps its sparse components' analyses
-	// between solves (on by default; the results are bitwise the same, see
-	// CoupledSystem.hpp; off for tests).
-	void setAnalysisReuse(bool reuse) { coupled_.setAnalysisReuse(reuse); }
+	// Whether the solver keeps work between solves: the sparse components'
+	// analyses (CoupledSystem.hpp) and, within an attempt, the terms of
+	// contacts that do not slip (keptTerms_). On by default; the results are
+	// bitwise the same (off for tests).
+	void setSolverReuse(bool reuse) {
+		coupled_.setAnalysisReuse(reuse);
+		keepTerms_ = reuse;
+	}
 	// Half the largest extent of the bounding box of all blocks [m] (Shi's w0),
 	// measured at the first step after blocks were added.
 	double sceneHalfSize();
@@ -119,6 +123,22 @@ private:
 	void solveAloneBlocks(const IntegratorSettings& settings, double dt);
 	// Adds the trial-state terms of every contact to coupled_ (counted in stats).
 	void assembleContacts(StepStatistics& stats);
+	// Within an attempt a contact's Newton terms (contactTerms) depend on its
+	// state alone unless it slips: the normal spring's on the start-of-step
+	// linearisation, the stick spring's on the anchors, neither of which
+	// moves before the attempt ends. So the terms of a contact that does not
+	// slip are kept (keptTerms_, up to kKeptTermsBytes in World.cpp) with the
+	// state they were made for (keptTermsKey_: closed, tangential term), and
+	// added again while it keeps that state: the same numbers, added in the
+	// same order. Cleared at each attempt's start.
+	struct KeptTerms {
+		Matrix24 stiffness;
+		Vector24 force;
+	};
+	std::vector<KeptTerms> keptTerms_;
+	std::vector<int> keptTermsOf_;             // per contact: its entry of keptTerms_, -1 if none
+	std::vector<unsigned char> keptTermsKey_;  // per contact: the state its kept terms are for
+	bool keepTerms_ = true;
 	// Adds the accepted step's dissipation, work of loads and contact springs'
 	// changes to the account (energy_), and records the springs' energy at its
 	// end; called before the contacts and blocks are moved.
