@@ -14,7 +14,8 @@ assert and what it costs:
 - contactChanges: the energy the contacts' springs gained between steps, over
   the same scale (negative: lost);
 - steps, solves per step, dt cuts, friction-limit passes and unsettled groups,
-  wall seconds.
+  wall and CPU seconds (this process; on a shared machine the CPU time is the
+  fairer measure).
 
 Writes bench/out/energy.json and prints a table. SI units.
 Run: make bench (or /usr/bin/python3 bench/energy.py [--youngs 1e5 1e11] [--time 0.6];
@@ -23,9 +24,11 @@ YADE_DDA_BUILD=<build>/py to use a build tree instead of the installed package).
 --pile200: the issue's scene instead, the pile of
 tests/py/test_energy_and_creep.py::test_pile_of_200_cubes_never_gains_energy
 (200 cubes in 8 layers of 5 x 5, 0.2 m apart, the same seed and builder), for
-1.5 s (the top layer lands at about 1.3 s), gain and speed sampled at every
-step; writes bench/out/energy_pile200.json. Not in `make bench`: it takes many
-minutes per E (see README, *Energy of a dropped pile*). --count/--side run
+1.5 s, gain and speed sampled at every step (allLandedAt: when the last cube
+left its free fall); a run stops early once a block is --stop-speed (10) times
+its free-fall bound (recorded as `stopped`); writes
+bench/out/energy_pile200.json. Not in `make bench`: it takes many minutes per
+E (see README, *Energy of a dropped pile*). --count/--side run
 other piles of that builder (written to energy_pile<count>.json). --threads
 sets DDAIntegrator.threads (results do not depend on it; 1 is fair to other
 users of the machine).
@@ -68,7 +71,7 @@ def small_pile(young, count):
     return cubes
 
 
-def run(young, duration, count=30, side=None, threads=0, every=10, progress=None):
+def run(young, duration, count=30, side=None, threads=0, every=10, progress=None, maxWall=None, stopSpeed=None):
     """side=None: the 30-cube bench pile; else the slow test's pile(count, young, SEED, side=side)."""
     O.reset()
     if side is None:
@@ -95,8 +98,8 @@ def run(young, duration, count=30, side=None, threads=0, every=10, progress=None
     def account(e):
         return e['kinetic'] + e['gravity'] + e['strain'] + e['contact'] + e['friction'] + e['damping'] - e['loads']
 
-    start = time.time()
-    O.run(1, True)
+    start, cpuStart = time.time(), time.process_time()
+    O.step()  # synchronous: O.run(1, True) waits about 40 ms per call for YADE's thread
     e0, _ = translational()
     top = max(block(b).centroid[2] for b in cubes)
     bound = math.sqrt(2 * G * top)
@@ -104,8 +107,15 @@ def run(young, duration, count=30, side=None, threads=0, every=10, progress=None
     gain, speed, drift, changes, steps, solves, cuts, passes, unsettled = 0.0, 0.0, 0.0, 0.0, 1, 0, 0, 0, 0
     searches, failures, mostSolves, gainAt, speedAt = 0, 0, 0, 0.0, 0.0
     nextReport = 0.0
+    stopped = None
     while O.time < duration:
-        O.run(1, True)
+        if maxWall is not None and time.time() - start > maxWall:
+            stopped = 'wall time above %g s' % maxWall
+            break
+        if stopSpeed is not None and speed > stopSpeed:
+            stopped = 'a block at %.3g x its free-fall bound' % speed
+            break
+        O.step()
         s = yade_dda.stats()
         steps += 1
         solves += s['openCloseIterationsTotal']
@@ -133,10 +143,13 @@ def run(young, duration, count=30, side=None, threads=0, every=10, progress=None
         changes = (a['contactChanges'] - a0['contactChanges']) / scale
     row = dict(young=young, blocks=count, time=O.time, gain=gain, speedOverFreeFall=speed, accountDrift=drift,
                contactChanges=changes, steps=steps, solvesPerStep=solves / steps, dtCuts=cuts, limitPasses=passes,
-               limitsUnsettled=unsettled, wallSeconds=time.time() - start)
+               limitsUnsettled=unsettled, wallSeconds=time.time() - start, cpuSeconds=time.process_time() - cpuStart)
     if side is not None:
-        row.update(allLandedAt=max(landed.values()) if len(landed) == len(cubes) else None, gainAt=gainAt, speedAt=speedAt, freeFallBound=bound, lineSearches=searches,
+        row.update(stopped=stopped, allLandedAt=max(landed.values()) if len(landed) == len(cubes) else None,
+                   gainAt=gainAt, speedAt=speedAt, freeFallBound=bound, lineSearches=searches,
                    openCloseFailures=failures, mostSolvesInStep=mostSolves, threads=threads)
+    elif stopped:
+        row['stopped'] = stopped
     return row
 
 
@@ -149,6 +162,9 @@ def main():
     parser.add_argument('--side', type=int, default=5, help='cubes per layer side with --count')
     parser.add_argument('--threads', type=int, default=0, help='DDAIntegrator.threads (0: all)')
     parser.add_argument('--progress', type=float, default=None, help='print a line every this many simulated s')
+    parser.add_argument('--max-wall', type=float, default=None, help='stop a run after this many wall seconds')
+    parser.add_argument('--stop-speed', type=float, default=10.0,
+                        help='with --count/--pile200: stop a run once a block is this many times its free-fall bound')
     parser.add_argument('--out', default=os.path.join(os.path.dirname(os.path.abspath(__file__)), 'out'))
     args = parser.parse_args()
     if args.pile200:
@@ -156,11 +172,12 @@ def main():
     big = args.count is not None
     duration = args.time if args.time is not None else (1.5 if big else 0.6)
     if big:
-        rows = [run(E, duration, args.count, args.side, args.threads, every=1, progress=args.progress)
-                for E in args.youngs]
+        rows = [run(E, duration, args.count, args.side, args.threads, every=1, progress=args.progress,
+                    maxWall=args.max_wall, stopSpeed=args.stop_speed) for E in args.youngs]
         name = 'energy_pile%d.json' % args.count
     else:
-        rows = [run(E, duration, threads=args.threads, progress=args.progress) for E in args.youngs]
+        rows = [run(E, duration, threads=args.threads, progress=args.progress, maxWall=args.max_wall)
+                for E in args.youngs]
         name = 'energy.json'
     os.makedirs(args.out, exist_ok=True)
     with open(os.path.join(args.out, name), 'w') as f:
