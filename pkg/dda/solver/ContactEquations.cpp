@@ -7,6 +7,8 @@ namespace dda {
 
 namespace {
 
+constexpr double kRoundoff = 0x1p-53;  // unit roundoff of double
+
 Matrix3 tangentProjector(const Vector3& normal) { return Matrix3::Identity() - normal * normal.transpose(); }
 
 // [T_i(x_i), -T_j(x_j)]: the relative displacement of two material points per unit of the 24 unknowns.
@@ -201,6 +203,104 @@ Vector3 tangentialForce(const Contact& contact, const Block& blockI, const Block
 	const double stretch = contact.stretch.norm();
 	if (!(stretch > 0)) return Vector3::Zero();
 	return -(contact.slipLimit * contact.stretch / stretch + slipStiffness(contact) * (s - contact.stretch));
+}
+
+double searchLine(const ContactLine* begin, const ContactLine* end, double slope, double curvature, bool certified,
+                  long* evaluations) {
+	long count = 0;
+	auto derivative = [&](double at) {
+		++count;
+		double value = slope + at * curvature;
+		for (const ContactLine* line = begin; line != end; ++line) value += line->derivative(at);
+		return value;
+	};
+	auto finish = [&](double t) {
+		if (evaluations) *evaluations += count;
+		return t;
+	};
+	const double atOne = derivative(1);
+	if (!(atOne > 0)) return finish(1);
+	// Certificates: every computed phi' at t <= negativeUpTo is negative, at
+	// t >= positiveFrom positive (none yet: outside [0, 1]).
+	double negativeUpTo = -1, positiveFrom = 2, bound = 0;
+	auto learn = [&](double at, double value) {
+		if (value < -2 * bound) negativeUpTo = std::max(negativeUpTo, at);
+		if (value > 2 * bound) positiveFrom = std::min(positiveFrom, at);
+	};
+	if (certified) {
+		// E: |computed - exact| over t in [0, 1]. Each term's rounding is a
+		// few units of roundoff u of a bound m_c on the sizes it is computed
+		// from (the normal term kn (|d| + |d'|) |d'|, zero and exact when the
+		// gap stays positive; the tangential one ks (|s|_1 + |s'|_1) |s'|_1
+		// + L |s'|_1, which also covers the two sides of the stick-slip
+		// branch); the sum's is (n - 1) u times the sum of the terms' sizes.
+		// Taken 4 x over (n + 20) u; a negative curvature (round-off of a
+		// quadratic form) makes phi' fall by at most |curvature| on [0, 1].
+		double size = std::abs(slope) + std::abs(curvature);
+		for (const ContactLine* line = begin; line != end; ++line) {
+			const double gap = line->gap, rate = line->gapRate;
+			const bool apart = !line->bonded && gap > 0 && gap + rate > 4 * kRoundoff * (gap + std::abs(rate));
+			if (!apart) size += line->normalStiffness * (std::abs(gap) + std::abs(rate)) * std::abs(rate);
+			if (line->tangential) {
+				const double s = line->stretch.cwiseAbs().sum(), r = line->stretchRate.cwiseAbs().sum();
+				size += line->shearStiffness * (s + r) * r + line->limit * r;
+			}
+		}
+		const double n = static_cast<double>(end - begin);
+		bound = 4 * (n + 20) * kRoundoff * size + (curvature < 0 ? -curvature : 0);
+		if (!std::isfinite(bound)) certified = false;
+	}
+	if (certified) {
+		learn(1, atOne);
+		// Regula falsi (Illinois) towards the root, each value a certificate
+		// when far enough from zero; stops once a value is within 2E (at the
+		// root as far as phi' can tell) or the certificates are 4e-12 apart.
+		double a = 0, fa = derivative(0), b = 1, fb = atOne;
+		learn(0, fa);
+		int side = 0;
+		for (int k = 0; k < 12 && fa <= 0 && positiveFrom - negativeUpTo > 4e-12; ++k) {
+			double p = a - fa * (b - a) / (fb - fa);
+			if (!(p > a && p < b)) p = 0.5 * (a + b);
+			const double fp = derivative(p);
+			learn(p, fp);
+			if (std::abs(fp) <= 2 * bound) {
+				// Certificates just outside the zone where phi' cannot tell
+				// its sign: about 2E over the slope on either side.
+				const double rise = (fb - fa) / (b - a);
+				double step = rise > 0 ? 4 * bound / rise : 1e-12;
+				for (int tries = 0; tries < 3 && positiveFrom - negativeUpTo > 4e-12; ++tries, step *= 4) {
+					if (p - step > negativeUpTo && p - step > 0) learn(p - step, derivative(p - step));
+					if (p + step < positiveFrom && p + step < 1) learn(p + step, derivative(p + step));
+				}
+				break;
+			}
+			if (fp > 0) {
+				b = p, fb = fp;
+				if (side == 1) fa *= 0.5;
+				side = 1;
+			} else {
+				a = p, fa = fp;
+				if (side == -1) fb *= 0.5;
+				side = -1;
+			}
+		}
+	}
+	double low = 0, high = 1;
+	for (int k = 0; k < 60 && high - low > 1e-12; ++k) {
+		const double mid = 0.5 * (low + high);
+		bool positive;
+		if (mid <= negativeUpTo)
+			positive = false;
+		else if (mid >= positiveFrom)
+			positive = true;
+		else {
+			const double value = derivative(mid);
+			positive = value > 0;
+			if (certified) learn(mid, value);
+		}
+		(positive ? high : low) = mid;
+	}
+	return finish(0.5 * (low + high));
 }
 
 ContactLine contactLine(const Contact& contact, const Block& blockI, const Block& blockJ, const Vector12& Di,

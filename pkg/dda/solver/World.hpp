@@ -85,8 +85,9 @@ public:
 	const Collider& collider() const { return *collider_; }
 	// Whether the solver keeps work between solves: the sparse components'
 	// analyses (CoupledSystem.hpp) and, within an attempt, the terms of
-	// contacts that do not slip (keptTerms_). On by default; the results are
-	// bitwise the same (off for tests).
+	// contacts that do not slip (keptTerms_); and whether the line search
+	// skips the evaluations whose sign is certain (searchLine). On by
+	// default; the results are bitwise the same (off for tests).
 	void setSolverReuse(bool reuse) {
 		coupled_.setAnalysisReuse(reuse);
 		keepTerms_ = reuse;
