@@ -159,8 +159,9 @@ def run(young, duration, count=30, side=None, threads=0, every=10, progress=None
                limitsUnsettled=unsettled, wallSeconds=time.time() - start, cpuSeconds=time.process_time() - cpuStart)
     if side is not None:
         row.update(stopped=stopped, allLandedAt=max(landed.values()) if len(landed) == len(cubes) else None,
-                   gainAt=gainAt, gainFullAt=gainFullAt, gainFullAbove1e3At=gainFullOver, speedAt=speedAt, freeFallBound=bound, lineSearches=searches,
-                   openCloseFailures=failures, mostSolvesInStep=mostSolves, threads=threads)
+                   gainAt=gainAt, gainFullAt=gainFullAt, gainFullAbove1e3At=gainFullOver, speedAt=speedAt,
+                   freeFallBound=bound, lineSearches=searches, openCloseFailures=failures,
+                   mostSolvesInStep=mostSolves, threads=threads)
     elif stopped:
         row['stopped'] = stopped
     return row
