@@ -8,7 +8,7 @@ DEB_PACKAGES := yade cmake g++ make libeigen3-dev libcgal-dev libgmp-dev libmpfr
                 libgtest-dev
 SITE_DIR := $(shell $(PYTHON) -c "import sysconfig;print(sysconfig.get_path('purelib','posix_local'))" 2>/dev/null)
 
-.PHONY: deps build install demo test test-hard test-cpp test-py bench regress regress-quick regress-run fuzz mutations clean
+.PHONY: deps build install demo test test-hard test-cpp test-py bench bench-pile200 regress regress-quick regress-run fuzz mutations clean
 
 deps:
 	@missing=$$(for p in $(DEB_PACKAGES); do dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null | grep -q 'install ok installed' || echo $$p; done); \
@@ -52,6 +52,11 @@ bench: install
 	$(PYTHON) bench/effects.py
 	$(PYTHON) bench/energy.py
 	$(PYTHON) bench/bounce.py
+
+# The issue-17 200-cube pile at 1e5..1e11 Pa (bench/out/energy_pile200.json): about half an hour
+# on one core, so not in `bench`.
+bench-pile200: install
+	$(PYTHON) bench/energy.py --pile200 --threads 1
 
 # Batch regressions (README, "Batch regressions"): yade-batch runs every row of a table in
 # examples/regression, each scene writes a record, check.py compares them with closed forms and

@@ -6,7 +6,8 @@ at its default, for 0.6 s. For each E it records what the hard-case tests
 assert and what it costs:
 - gain: the largest rise of kinetic (translation) plus potential energy above
   its start, relative to the start (must stay below 1e-3; the contact law
-  before issue 17 gained 5-36% on 200 cubes at 1e11 Pa);
+  before issue 17 gained 5-36% on 200 cubes at 1e11 Pa); gainFull: the same
+  with the energy account's kinetic energy (rotation and strain rates too);
 - speed: the fastest centroid over the free-fall bound sqrt(2 g z_top) (<= 1);
 - drift: the energy account's sum minus loads minus contactChanges, its change
   over the run relative to the largest change of any term (the account's
@@ -14,7 +15,8 @@ assert and what it costs:
 - contactChanges: the energy the contacts' springs gained between steps, over
   the same scale (negative: lost);
 - steps, solves per step, dt cuts, friction-limit passes and unsettled groups,
-  wall seconds.
+  wall and CPU seconds (this process; on a shared machine the CPU time is the
+  fairer measure).
 
 Writes bench/out/energy.json and prints a table. SI units.
 Run: make bench (or /usr/bin/python3 bench/energy.py [--youngs 1e5 1e11] [--time 0.6];
@@ -23,9 +25,12 @@ YADE_DDA_BUILD=<build>/py to use a build tree instead of the installed package).
 --pile200: the issue's scene instead, the pile of
 tests/py/test_energy_and_creep.py::test_pile_of_200_cubes_never_gains_energy
 (200 cubes in 8 layers of 5 x 5, 0.2 m apart, the same seed and builder), for
-1.5 s (the top layer lands at about 1.3 s), gain and speed sampled at every
-step; writes bench/out/energy_pile200.json. Not in `make bench`: it takes many
-minutes per E (see README, *Energy of a dropped pile*). --count/--side run
+1.5 s, gain and speed sampled at every step (allLandedAt: when the last cube
+left its free fall); a run stops early once a block is --stop-speed (10) times
+its free-fall bound, or gainFull is above --stop-gain (0.5) (recorded as
+`stopped`); writes
+bench/out/energy_pile200.json. Not in `make bench`: it takes many minutes per
+E (see README, *Energy of a dropped pile*). --count/--side run
 other piles of that builder (written to energy_pile<count>.json). --threads
 sets DDAIntegrator.threads (results do not depend on it; 1 is fair to other
 users of the machine).
@@ -68,7 +73,8 @@ def small_pile(young, count):
     return cubes
 
 
-def run(young, duration, count=30, side=None, threads=0, every=10, progress=None):
+def run(young, duration, count=30, side=None, threads=0, every=10, progress=None, maxWall=None, stopSpeed=None,
+        stopGain=None):
     """side=None: the 30-cube bench pile; else the slow test's pile(count, young, SEED, side=side)."""
     O.reset()
     if side is None:
@@ -95,17 +101,29 @@ def run(young, duration, count=30, side=None, threads=0, every=10, progress=None
     def account(e):
         return e['kinetic'] + e['gravity'] + e['strain'] + e['contact'] + e['friction'] + e['damping'] - e['loads']
 
-    start = time.time()
-    O.run(1, True)
+    start, cpuStart = time.time(), time.process_time()
+    O.step()  # synchronous: O.run(1, True) waits about 40 ms per call for YADE's thread
     e0, _ = translational()
     top = max(block(b).centroid[2] for b in cubes)
     bound = math.sqrt(2 * G * top)
     a0 = dict(yade_dda.stats()['energy'])
+    full0 = a0['kinetic'] + a0['gravity']
+    gainFull, gainFullAt, gainFullOver = 0.0, 0.0, None
     gain, speed, drift, changes, steps, solves, cuts, passes, unsettled = 0.0, 0.0, 0.0, 0.0, 1, 0, 0, 0, 0
     searches, failures, mostSolves, gainAt, speedAt = 0, 0, 0, 0.0, 0.0
     nextReport = 0.0
+    stopped = None
     while O.time < duration:
-        O.run(1, True)
+        if maxWall is not None and time.time() - start > maxWall:
+            stopped = 'wall time above %g s' % maxWall
+            break
+        if stopSpeed is not None and speed > stopSpeed:
+            stopped = 'a block at %.3g x its free-fall bound' % speed
+            break
+        if stopGain is not None and gainFull > stopGain:
+            stopped = 'kinetic (all rates) plus potential energy %.3g above its start' % gainFull
+            break
+        O.step()
         s = yade_dda.stats()
         steps += 1
         solves += s['openCloseIterationsTotal']
@@ -128,15 +146,24 @@ def run(young, duration, count=30, side=None, threads=0, every=10, progress=None
         if fastest / bound > speed:
             speed, speedAt = fastest / bound, O.time
         a = s['energy']
+        if (a['kinetic'] + a['gravity'] - full0) / full0 > gainFull:
+            gainFull, gainFullAt = (a['kinetic'] + a['gravity'] - full0) / full0, O.time
+            if gainFull > 1e-3 and gainFullOver is None:
+                gainFullOver = O.time
         scale = max(abs(a[k] - a0[k]) for k in a)
         drift = max(drift, abs(account(a) - account(a0) - (a['contactChanges'] - a0['contactChanges'])) / scale)
         changes = (a['contactChanges'] - a0['contactChanges']) / scale
-    row = dict(young=young, blocks=count, time=O.time, gain=gain, speedOverFreeFall=speed, accountDrift=drift,
+    row = dict(young=young, blocks=count, time=O.time, gain=gain, gainFull=gainFull, speedOverFreeFall=speed,
+               accountDrift=drift,
                contactChanges=changes, steps=steps, solvesPerStep=solves / steps, dtCuts=cuts, limitPasses=passes,
-               limitsUnsettled=unsettled, wallSeconds=time.time() - start)
+               limitsUnsettled=unsettled, wallSeconds=time.time() - start, cpuSeconds=time.process_time() - cpuStart)
     if side is not None:
-        row.update(allLandedAt=max(landed.values()) if len(landed) == len(cubes) else None, gainAt=gainAt, speedAt=speedAt, freeFallBound=bound, lineSearches=searches,
-                   openCloseFailures=failures, mostSolvesInStep=mostSolves, threads=threads)
+        row.update(stopped=stopped, allLandedAt=max(landed.values()) if len(landed) == len(cubes) else None,
+                   gainAt=gainAt, gainFullAt=gainFullAt, gainFullAbove1e3At=gainFullOver, speedAt=speedAt,
+                   freeFallBound=bound, lineSearches=searches, openCloseFailures=failures,
+                   mostSolvesInStep=mostSolves, threads=threads)
+    elif stopped:
+        row['stopped'] = stopped
     return row
 
 
@@ -149,6 +176,11 @@ def main():
     parser.add_argument('--side', type=int, default=5, help='cubes per layer side with --count')
     parser.add_argument('--threads', type=int, default=0, help='DDAIntegrator.threads (0: all)')
     parser.add_argument('--progress', type=float, default=None, help='print a line every this many simulated s')
+    parser.add_argument('--max-wall', type=float, default=None, help='stop a run after this many wall seconds')
+    parser.add_argument('--stop-speed', type=float, default=10.0,
+                        help='with --count/--pile200: stop a run once a block is this many times its free-fall bound')
+    parser.add_argument('--stop-gain', type=float, default=0.5,
+                        help='with --count/--pile200: stop a run once gainFull is above this (blown up)')
     parser.add_argument('--out', default=os.path.join(os.path.dirname(os.path.abspath(__file__)), 'out'))
     args = parser.parse_args()
     if args.pile200:
@@ -156,21 +188,23 @@ def main():
     big = args.count is not None
     duration = args.time if args.time is not None else (1.5 if big else 0.6)
     if big:
-        rows = [run(E, duration, args.count, args.side, args.threads, every=1, progress=args.progress)
-                for E in args.youngs]
+        rows = [run(E, duration, args.count, args.side, args.threads, every=1, progress=args.progress,
+                    maxWall=args.max_wall, stopSpeed=args.stop_speed, stopGain=args.stop_gain) for E in args.youngs]
         name = 'energy_pile%d.json' % args.count
     else:
-        rows = [run(E, duration, threads=args.threads, progress=args.progress) for E in args.youngs]
+        rows = [run(E, duration, threads=args.threads, progress=args.progress, maxWall=args.max_wall)
+                for E in args.youngs]
         name = 'energy.json'
     os.makedirs(args.out, exist_ok=True)
     with open(os.path.join(args.out, name), 'w') as f:
         json.dump(dict(seed=SEED, rows=rows), f, indent=1)
-    print('%8s %9s %8s %9s %9s %6s %7s %5s %7s %6s' % ('E [Pa]', 'gain', 'speed', 'drift', 'changes', 'steps',
-                                                        'solves', 'cuts', 'passes', 'wall'))
+    print('%8s %9s %9s %8s %9s %9s %6s %7s %5s %7s %6s' % ('E [Pa]', 'gain', 'gainFull', 'speed', 'drift', 'changes',
+                                                             'steps', 'solves', 'cuts', 'passes', 'cpu'))
     for r in rows:
-        print('%8.0e %9.1e %8.3f %9.1e %9.1e %6d %7.1f %5d %7d %6.1f' % (
-            r['young'], r['gain'], r['speedOverFreeFall'], r['accountDrift'], r['contactChanges'], r['steps'],
-            r['solvesPerStep'], r['dtCuts'], r['limitPasses'], r['wallSeconds']))
+        print('%8.0e %9.1e %9.1e %8.3f %9.1e %9.1e %6d %7.1f %5d %7d %6.1f%s' % (
+            r['young'], r['gain'], r['gainFull'], r['speedOverFreeFall'], r['accountDrift'], r['contactChanges'],
+            r['steps'], r['solvesPerStep'], r['dtCuts'], r['limitPasses'], r['cpuSeconds'],
+            ' (stopped at %.4f s: %s)' % (r['time'], r['stopped']) if r.get('stopped') else ''))
 
 
 if __name__ == '__main__':

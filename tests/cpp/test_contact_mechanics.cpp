@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <random>
+#include <vector>
 
 using namespace dda;
 
@@ -313,3 +315,96 @@ TEST(ContactMechanics, SecantForceIsTheDiscreteGradientOfTheSpringEnergy) {
 	EXPECT_TRUE(std::isfinite(normalSecant(false, kn, 0.0, 1e-4).value));
 	EXPECT_TRUE(std::isfinite(normalSecant(false, kn, 1e-4, 0.0).value));
 }
+
+// The line search's bisection (searchLine) with and without the certified
+// skipping of evaluations: bitwise the same step on random groups of lines
+// (compressed, opening and bonded normal springs, sticking and slipping
+// shear springs, sizes over six decades, the root placed anywhere in (0, 1)
+// or at a kink, and groups whose derivative is mostly round-off), with far
+// fewer evaluations where the derivative is not. Under Shi's scheme, and
+// under Newmark members with gamma in [1/2, 1) (the secant normal force from
+// a random start gap, the springs weighted as Contact weights them).
+namespace {
+void certifiedSearchTrials(bool secant) {
+	std::mt19937 rng(secant ? 2025 : 2024);
+	std::uniform_real_distribution<double> u(0, 1);
+	auto logUniform = [&](double lo, double hi) { return lo * std::pow(hi / lo, u(rng)); };
+	auto sign = [&]() { return u(rng) < 0.5 ? -1.0 : 1.0; };
+	long plainEvaluations = 0, certifiedEvaluations = 0, searched = 0;
+	for (int trial = 0; trial < 4000; ++trial) {
+		const int count = static_cast<int>(logUniform(1, 3000));
+		// 0, 1: generic; 2: root at a kink; 3: small rates; 4: pairs of deep
+		// contacts whose terms cancel, so that the computed derivative is
+		// round-off over a wide zone about the root (not monotone there).
+		const int kind = trial % 5;
+		// Average acceleration (1/2) in a quarter of the trials, where the
+		// spring's weight is 0 and the secant carries the normal force.
+		const double gamma = !secant ? 1.0 : trial % 4 == 0 ? 0.5 : 0.5 + 0.5 * u(rng);
+		std::vector<ContactLine> lines(count);
+		for (ContactLine& line : lines) {
+			line.normalStiffness = 4e12;
+			line.shearStiffness = 1.6e12;
+			line.gap = u(rng) < 0.4 ? -logUniform(1e-10, 1e-6) : logUniform(1e-10, 1e-5);
+			line.gapRate = sign() * logUniform(1e-12, 1e-6);
+			line.bonded = u(rng) < 0.05;
+			line.tangential = u(rng) < 0.6;
+			if (line.tangential) {
+				for (int i = 0; i < 3; ++i) {
+					line.stretch(i) = sign() * logUniform(1e-11, 1e-6);
+					line.stretchRate(i) = sign() * logUniform(1e-12, 1e-6);
+				}
+				line.limit = logUniform(1e2, 1e7);
+			}
+			if (kind == 3) line.gapRate *= 1e-4;
+			if (secant) {
+				// As prepareContact and contactLine set them.
+				line.springWeight = (2 * gamma - 1) / gamma;
+				line.secantWeight = 2 * (1 - gamma) / gamma;
+				line.tangentialWeight = 1 / gamma;
+				// The start gap: closed or apart, about the gap or far from it.
+				line.startGap = u(rng) < 0.3 ? line.gap + sign() * logUniform(1e-12, 1e-6)
+				                             : (u(rng) < 0.5 ? -1.0 : 1.0) * logUniform(1e-10, 1e-5);
+			}
+		}
+		if (kind == 4)
+			for (int c = 0; c + 1 < count; c += 2) {
+				ContactLine &first = lines[c], &second = lines[c + 1];
+				first.bonded = second.bonded = false;
+				first.tangential = second.tangential = false;
+				first.gap = second.gap = -logUniform(1e-3, 1e-1);
+				first.gapRate = logUniform(1e-13, 1e-10);
+				second.gapRate = -first.gapRate;
+				if (secant) first.startGap = second.startGap = -logUniform(1e-3, 1e-1);
+			}
+		double curvature = logUniform(1e-3, 1e3) * (kind >= 3 ? 1e-6 : 1.0);
+		double root = u(rng);
+		if (kind == 2) {
+			// At a normal spring's kink: where its gap changes sign.
+			ContactLine& line = lines[static_cast<std::size_t>(u(rng) * count) % count];
+			line.bonded = false;
+			root = std::min(0.999, std::max(0.001, root));
+			line.gap = -root * line.gapRate;
+		}
+		double atRoot = root * curvature;
+		for (const ContactLine& line : lines) atRoot += line.derivative(root);
+		const double slope = -atRoot;
+		long plain = 0, certified = 0;
+		const double a = searchLine(lines.data(), lines.data() + count, slope, curvature, false, &plain);
+		const double b = searchLine(lines.data(), lines.data() + count, slope, curvature, true, &certified);
+		ASSERT_EQ(a, b) << "trial " << trial << " lines " << count << " kind " << kind;
+		if (a < 1) {
+			++searched;
+			plainEvaluations += plain;
+			certifiedEvaluations += certified;
+		}
+	}
+	EXPECT_GT(searched, 2400);
+	EXPECT_LT(certifiedEvaluations, 0.6 * plainEvaluations) << certifiedEvaluations << " of " << plainEvaluations;
+	std::printf("%s: evaluations: %ld certified, %ld plain, %ld searches\n", secant ? "gamma < 1" : "Shi",
+	            certifiedEvaluations, plainEvaluations, searched);
+}
+}  // namespace
+
+TEST(ContactMechanics, CertifiedLineSearchTakesTheBisectionsStep) { certifiedSearchTrials(false); }
+
+TEST(ContactMechanics, CertifiedLineSearchTakesTheBisectionsStepWithTheSecant) { certifiedSearchTrials(true); }

@@ -4,7 +4,8 @@
 // stack); fixed-fixed pairs never searched and MSC shells of fixed blocks
 // built once; no friction terms without friction, no body force without
 // gravity, static analysis (velocityRatio = 0); no stored system for blocks
-// without springs; sparse analyses kept between solves. Counters, not timings.
+// without springs; sparse analyses and contact terms kept between solves.
+// Counters, not timings.
 #include "dda/collider/Collider.hpp"
 #include "dda/collider/MSCCollider.hpp"
 #include "dda/solver/CoupledSystem.hpp"
@@ -14,6 +15,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <random>
 
@@ -363,21 +365,25 @@ TEST(Effects, SparseAnalysisReuseGivesBitwiseTheFreshSolutions) {
 	EXPECT_EQ(reusedCount, 30);
 }
 
-// The same on a settling pile: every step bitwise the same with and without
-// the kept analyses (vertices, velocities and the iteration's counts).
-TEST(Effects, SparseAnalysisReuseLeavesAPileBitwiseTheSame) {
-	World reused = pile(std::make_unique<DESSCollider>(), 5, 0.3);
-	World fresh = pile(std::make_unique<DESSCollider>(), 5, 0.3);
-	fresh.setAnalysisReuse(false);
-	IntegratorSettings settings = gravitySettings(true);
-	int coupledSteps = 0;
-	for (int step = 0; step < 300; ++step) {
+namespace {
+// Steps two copies of a pile, one with and one without the work the solver
+// keeps between solves, and compares every step bitwise (vertices,
+// velocities and the iteration's counts).
+void expectSolverReuseBitwise(int layers, const IntegratorSettings& settings, int steps) {
+	World reused = pile(std::make_unique<DESSCollider>(), layers, 0.3);
+	World fresh = pile(std::make_unique<DESSCollider>(), layers, 0.3);
+	fresh.setSolverReuse(false);
+	int coupledSteps = 0, laterSolves = 0, searches = 0;
+	for (int step = 0; step < steps; ++step) {
 		reused.step(settings);
 		fresh.step(settings);
 		const StepStatistics &a = reused.lastStep(), &b = fresh.lastStep();
 		ASSERT_EQ(a.openCloseIterationsTotal, b.openCloseIterationsTotal) << "step " << step;
 		ASSERT_EQ(a.stepCuts, b.stepCuts) << "step " << step;
+		ASSERT_EQ(a.lineSearches, b.lineSearches) << "step " << step;
 		coupledSteps += a.largestComponent > 1;
+		laterSolves += a.openCloseIterationsTotal - (a.stepCuts + 1);
+		searches += a.lineSearches;
 		for (int k = 0; k < reused.blockCount(); ++k) {
 			ASSERT_EQ(reused.block(k).velocity, fresh.block(k).velocity) << "step " << step << " block " << k;
 			for (std::size_t v = 0; v < reused.block(k).vertices.size(); ++v)
@@ -385,4 +391,26 @@ TEST(Effects, SparseAnalysisReuseLeavesAPileBitwiseTheSame) {
 		}
 	}
 	EXPECT_GT(coupledSteps, 100);  // the sparse path was taken
+	EXPECT_GT(laterSolves, 100);   // solves after an attempt's first, which add kept terms
+	EXPECT_GT(searches, 0);        // line searches, certified in `reused`
+	EXPECT_GT(reused.memoryUse().solver, fresh.memoryUse().solver);  // terms and analyses were kept
+	std::printf("%d steps: %d coupled, %d later solves, %d line searches\n", steps, coupledSteps, laterSolves,
+	            searches);
+}
+}  // namespace
+
+// The same on a settling pile: every step bitwise the same with and without
+// the work the solver keeps between solves (the sparse analyses, the terms
+// of contacts that neither slip nor carry a secant force, the certified line
+// search).
+TEST(Effects, SolverReuseLeavesAPileBitwiseTheSame) { expectSolverReuseBitwise(5, gravitySettings(true), 300); }
+
+// And under average acceleration (beta 1/4, gamma 1/2), where every closed
+// contact's normal force is the secant's (not kept) and the line search's
+// bound covers the secant term: 29 cubes.
+TEST(Effects, SolverReuseLeavesAPileBitwiseTheSameUnderAverageAcceleration) {
+	IntegratorSettings settings = gravitySettings(true);
+	settings.newmarkBeta = 0.25;
+	settings.newmarkGamma = 0.5;
+	expectSolverReuseBitwise(7, settings, 300);
 }

@@ -7,6 +7,8 @@ namespace dda {
 
 namespace {
 
+constexpr double kRoundoff = 0x1p-53;  // unit roundoff of double
+
 Matrix3 tangentProjector(const Vector3& normal) { return Matrix3::Identity() - normal * normal.transpose(); }
 
 // [T_i(x_i), -T_j(x_j)]: the relative displacement of two material points per unit of the 24 unknowns.
@@ -272,19 +274,129 @@ Vector3 tangentialForce(const Contact& contact, const Block& blockI, const Block
 	return -(contact.slipLimit * contact.stretch / stretch + slipStiffness(contact) * (s - contact.stretch));
 }
 
-double ContactLine::derivative(double t) const {
-	const double gapAt = gap + t * gapRate;
-	double value = springWeight * normalStiffness * (bonded ? gapAt : std::min(0.0, gapAt)) * gapRate;
-	if (secantWeight > 0) value += secantWeight * normalSecant(bonded, normalStiffness, startGap, gapAt).value * gapRate;
-	if (tangential) {
-		const Vector3 s = stretch + t * stretchRate;
-		const double norm = s.norm();
-		if (shearStiffness * norm <= limit)
-			value += tangentialWeight * shearStiffness * s.dot(stretchRate);
-		else
-			value += tangentialWeight * limit * s.dot(stretchRate) / norm;
+double searchLine(const ContactLine* begin, const ContactLine* end, double slope, double curvature, bool certified,
+                  long* evaluations) {
+	long count = 0;
+	auto derivative = [&](double at) {
+		++count;
+		double value = slope + at * curvature;
+		for (const ContactLine* line = begin; line != end; ++line) value += line->derivative(at);
+		return value;
+	};
+	auto finish = [&](double t) {
+		if (evaluations) *evaluations += count;
+		return t;
+	};
+	const double atOne = derivative(1);
+	if (!(atOne > 0)) return finish(1);
+	// Certificates: every computed phi' at t <= negativeUpTo is negative, at
+	// t >= positiveFrom positive (none yet: outside [0, 1]).
+	double negativeUpTo = -1, positiveFrom = 2, bound = 0;
+	auto learn = [&](double at, double value) {
+		if (value < -2 * bound) negativeUpTo = std::max(negativeUpTo, at);
+		if (value > 2 * bound) positiveFrom = std::min(positiveFrom, at);
+	};
+	if (certified) {
+		// E: |computed - exact| over t in [0, 1]. Each term's rounding is a
+		// few units of roundoff u of a bound m_c on the sizes it is computed
+		// from (the normal spring's w_s kn (|d| + |d'|) |d'|, zero and exact
+		// when the gap stays positive; the tangential one w_t (ks (|s|_1 +
+		// |s'|_1) |s'|_1 + L |s'|_1), which also covers the two sides of the
+		// stick-slip branch); the sum's is (n - 1) u times the sum of the
+		// terms' sizes. Taken 4 x over (n + 20) u; a negative curvature
+		// (round-off of a quadratic form) makes phi' fall by at most
+		// |curvature| on [0, 1]. w_s, w_c, w_t are the line's springWeight,
+		// secantWeight, tangentialWeight (1, 0, 1 under Shi's scheme, where
+		// E is the same number as without them).
+		//
+		// The secant term (gamma < 1) w_c h(d) d', with d = d(0) + t d' the
+		// gap and h = normalSecant(d0, d).value, has m_c = w_c kn (|d(0)| +
+		// |d'| + |d0|) |d'|. Exact h rises with d (ContactEquations.hpp), so
+		// the exact phi' still rises with t, and:
+		// - the computed gap misses d by at most 2u (|d(0)| + |d'|) (t d'
+		//   and the sum, t in [0, 1]);
+		// - h is continuous with 0 <= h' <= kn/2 in every branch (closed:
+		//   kn/2; released: kn d0^2 / 2q^2 with |q| = |d - d0| >= |d0|;
+		//   closing: kn (d^2 - 2 d d0) / 2q^2 <= kn/2 as q^2 = that +
+		//   d0^2), so that miss moves h by at most u kn (|d(0)| + |d'|);
+		// - each branch evaluated at the computed gap rounds by at most
+		//   about 4u (q's rounding and three operations) of its size,
+		//   which is at most kn/2 (|d| + |d0|): kn |d + d0|/2 closed,
+		//   kn d0^2 / 2|q| <= kn |d0|/2 released, kn d^2 / 2|q| <= kn |d|/2
+		//   closing;
+		// - the two products with w_c and d' add 2u of |w_c h d'|.
+		// Together about 5u m_c, within the 4 (n + 20) u taken. Apart at
+		// both ends (d0 > 0 and the gap positive over the line) the secant
+		// is exactly 0, computed and exact.
+		double size = std::abs(slope) + std::abs(curvature);
+		for (const ContactLine* line = begin; line != end; ++line) {
+			const double gap = line->gap, rate = std::abs(line->gapRate);
+			const bool apart =
+			    !line->bonded && gap > 0 && gap + line->gapRate > 4 * kRoundoff * (gap + rate);
+			if (!apart) size += line->springWeight * line->normalStiffness * (std::abs(gap) + rate) * rate;
+			if (line->secantWeight > 0 && !(apart && line->startGap > 0))
+				size += line->secantWeight * line->normalStiffness *
+				        (std::abs(gap) + rate + std::abs(line->startGap)) * rate;
+			if (line->tangential) {
+				const double s = line->stretch.cwiseAbs().sum(), r = line->stretchRate.cwiseAbs().sum();
+				size += line->tangentialWeight * (line->shearStiffness * (s + r) * r + line->limit * r);
+			}
+		}
+		const double n = static_cast<double>(end - begin);
+		bound = 4 * (n + 20) * kRoundoff * size + (curvature < 0 ? -curvature : 0);
+		if (!std::isfinite(bound)) certified = false;
 	}
-	return value;
+	if (certified) {
+		learn(1, atOne);
+		// Regula falsi (Illinois) towards the root, each value a certificate
+		// when far enough from zero; stops once a value is within 2E (at the
+		// root as far as phi' can tell) or the certificates are 4e-12 apart.
+		double a = 0, fa = derivative(0), b = 1, fb = atOne;
+		learn(0, fa);
+		int side = 0;
+		for (int k = 0; k < 12 && fa <= 0 && positiveFrom - negativeUpTo > 4e-12; ++k) {
+			double p = a - fa * (b - a) / (fb - fa);
+			if (!(p > a && p < b)) p = 0.5 * (a + b);
+			const double fp = derivative(p);
+			learn(p, fp);
+			if (std::abs(fp) <= 2 * bound) {
+				// Certificates just outside the zone where phi' cannot tell
+				// its sign: about 2E over the slope on either side.
+				const double rise = (fb - fa) / (b - a);
+				double step = rise > 0 ? 4 * bound / rise : 1e-12;
+				for (int tries = 0; tries < 3 && positiveFrom - negativeUpTo > 4e-12; ++tries, step *= 4) {
+					if (p - step > negativeUpTo && p - step > 0) learn(p - step, derivative(p - step));
+					if (p + step < positiveFrom && p + step < 1) learn(p + step, derivative(p + step));
+				}
+				break;
+			}
+			if (fp > 0) {
+				b = p, fb = fp;
+				if (side == 1) fa *= 0.5;
+				side = 1;
+			} else {
+				a = p, fa = fp;
+				if (side == -1) fb *= 0.5;
+				side = -1;
+			}
+		}
+	}
+	double low = 0, high = 1;
+	for (int k = 0; k < 60 && high - low > 1e-12; ++k) {
+		const double mid = 0.5 * (low + high);
+		bool positive;
+		if (mid <= negativeUpTo)
+			positive = false;
+		else if (mid >= positiveFrom)
+			positive = true;
+		else {
+			const double value = derivative(mid);
+			positive = value > 0;
+			if (certified) learn(mid, value);
+		}
+		(positive ? high : low) = mid;
+	}
+	return finish(0.5 * (low + high));
 }
 
 ContactLine contactLine(const Contact& contact, const Block& blockI, const Block& blockJ, const Vector12& Di,

@@ -66,6 +66,9 @@ constexpr int kFullNewtonSolves = 4;
 constexpr double kSettleFrictionScale = 1e6;
 constexpr double kSettleTolerance = 1e-6;
 constexpr int kSettleSteps = 12;
+// Heap for the contact terms kept within an attempt (World::keptTerms_):
+// about 3,400 contacts; the others' terms are made at every solve.
+constexpr std::size_t kKeptTermsBytes = std::size_t(16) << 20;
 double secondsSince(Clock::time_point start) {
 	return std::chrono::duration<double>(Clock::now() - start).count();
 }
@@ -504,7 +507,8 @@ World::MemoryUse World::memoryUse() const {
 	             capacityBytes(ownSystemOf_) + capacityBytes(solvedAlone_) + capacityBytes(links_) +
 	             capacityBytes(hasSprings_) + capacityBytes(blockUnknowns_) + capacityBytes(iterate_) +
 	             capacityBytes(deltas_) + capacityBytes(lines_) + capacityBytes(groupRoot_) + capacityBytes(lineGroup_) +
-	             capacityBytes(groupLines_) + capacityBytes(lineOrder_) + capacityBytes(groupKink_) +
+	             capacityBytes(groupLines_) + capacityBytes(orderedLines_) + capacityBytes(keptTerms_) +
+	             capacityBytes(keptTermsOf_) + capacityBytes(keptTermsKey_) + capacityBytes(groupKink_) +
 	             capacityBytes(groupSlope_) + capacityBytes(groupCurvature_) + capacityBytes(groupStep_) +
 	             capacityBytes(contactGroup_) + capacityBytes(startAccelerations_) + group_.memoryBytes();
 	return use;
@@ -569,15 +573,55 @@ void World::solveAloneBlocks(const IntegratorSettings& settings, double dt) {
 }
 
 void World::assembleContacts(StepStatistics& stats) {
-	Matrix24 stiffness;
-	Vector24 force;
-	for (const Contact& contact : store_.contacts()) {
+	Matrix24 stiffnessWork;
+	Vector24 forceWork;
+	const std::vector<Contact>& contacts = store_.contacts();
+	keptTermsOf_.resize(contacts.size(), -1);
+	keptTermsKey_.resize(contacts.size(), 0);
+	for (std::size_t c = 0; c < contacts.size(); ++c) {
+		const Contact& contact = contacts[c];
 		const int bi = contact.key.blockI, bj = contact.key.blockJ;
-		if (!contactTerms(contact, blocks_[bi], blocks_[bj], stiffness, force)) continue;
+		const bool normalTerms = hasNormalTerms(contact);
+		const TangentialTerm tangential = tangentialTerm(contact);
+		// No terms (what contactTerms returns false for).
+		if (!normalTerms && tangential == TangentialTerm::None) continue;
+		// Kept terms while the state is the one they were made for (see
+		// keptTerms_ in World.hpp): not a slipping contact's, which depend
+		// on its stretch, nor a secant's (gamma < 1), which depend on its
+		// trial gap; both are made anew at every solve.
+		const bool keepable =
+		    tangential != TangentialTerm::FrictionLoad && !(normalTerms && contact.secantWeight > 0);
+		const unsigned char key = static_cast<unsigned char>(1 + normalTerms + 2 * static_cast<int>(tangential));
+		const Matrix24* stiffnessOf = &stiffnessWork;
+		const Vector24* forceOf = &forceWork;
+		const int kept = keptTermsOf_[c];
+		if (keepable && kept >= 0 && keptTermsKey_[c] == key) {
+			stiffnessOf = &keptTerms_[kept].stiffness;
+			forceOf = &keptTerms_[kept].force;
+		} else {
+			contactTerms(contact, blocks_[bi], blocks_[bj], stiffnessWork, forceWork);
+			if (keepTerms_ && keepable &&
+			    (kept >= 0 || (keptTerms_.size() + 1) * sizeof(KeptTerms) <= kKeptTermsBytes)) {
+				if (kept < 0) {
+					// Grown by hand so that its capacity stays within the budget.
+					if (keptTerms_.size() == keptTerms_.capacity())
+						keptTerms_.reserve(std::min(std::max<std::size_t>(64, 2 * keptTerms_.capacity()),
+						                            kKeptTermsBytes / sizeof(KeptTerms)));
+					keptTermsOf_[c] = static_cast<int>(keptTerms_.size());
+					keptTerms_.emplace_back();
+				}
+				KeptTerms& entry = keptTerms_[keptTermsOf_[c]];
+				entry.stiffness = stiffnessWork;
+				entry.force = forceWork;
+				keptTermsKey_[c] = key;
+			}
+		}
+		const Matrix24& stiffness = *stiffnessOf;
+		const Vector24& force = *forceOf;
 		// An open contact may carry its tangential spring alone (its limit is
 		// held for the pass): only closed ones have a normal spring.
-		stats.normalTerms += hasNormalTerms(contact);
-		stats.frictionTerms += tangentialTerm(contact) != TangentialTerm::None;
+		stats.normalTerms += normalTerms;
+		stats.frictionTerms += tangential != TangentialTerm::None;
 		const int mi = movingIndex_[bi], mj = movingIndex_[bj];
 		if (mi >= 0) {
 			coupled_.diagonal(mi) += stiffness.topLeftCorner<12, 12>();
@@ -725,34 +769,27 @@ double World::lineSearch(const IntegratorSettings& settings, double dt) {
 	}
 	// The lines of each searched group, together (a counting sort by group).
 	groupStep_.assign(n, 1.0);
-	lineOrder_.clear();
 	groupLines_.assign(n + 1, 0);
 	for (std::size_t c = 0; c < lines_.size(); ++c)
 		if (groupKink_[lineGroup_[c]]) ++groupLines_[lineGroup_[c] + 1];
 	for (int g = 0; g < n; ++g) groupLines_[g + 1] += groupLines_[g];
-	lineOrder_.resize(groupLines_[n]);
+	// Copied in that order, so the bisection reads each group's lines
+	// contiguously (and sums them in the same order as before).
+	orderedLines_.resize(groupLines_[n]);
 	{
 		std::vector<int> next(groupLines_.begin(), groupLines_.end() - 1);
 		for (std::size_t c = 0; c < lines_.size(); ++c)
-			if (groupKink_[lineGroup_[c]]) lineOrder_[next[lineGroup_[c]]++] = static_cast<int>(c);
+			if (groupKink_[lineGroup_[c]]) orderedLines_[next[lineGroup_[c]]++] = lines_[c];
 	}
 	double smallest = 1;
 	for (int g = 0; g < n; ++g) {
 		if (!groupKink_[g] || group_.done[g]) continue;
-		auto derivative = [&](double at) {
-			double value = groupSlope_[g] + at * groupCurvature_[g];
-			for (int c = groupLines_[g]; c < groupLines_[g + 1]; ++c) value += lines_[lineOrder_[c]].derivative(at);
-			return value;
-		};
-		if (!(derivative(1) > 0)) continue;
-		double low = 0, high = 1;
-		for (int k = 0; k < 60 && high - low > 1e-12; ++k) {
-			const double mid = 0.5 * (low + high);
-			(derivative(mid) > 0 ? high : low) = mid;
-		}
+		// Bisection on the derivative (searchLine; certified: the same
+		// result with fewer evaluations).
+		const double t = searchLine(orderedLines_.data() + groupLines_[g], orderedLines_.data() + groupLines_[g + 1],
+		                            groupSlope_[g], groupCurvature_[g], keepTerms_);
 		// A step this close to the full one lowers the energy by no
 		// measurable amount more: take the Newton point.
-		const double t = 0.5 * (low + high);
 		if (t <= 1 - 1e-9) groupStep_[g] = t;
 		smallest = std::min(smallest, groupStep_[g]);
 	}
@@ -1052,6 +1089,8 @@ double World::advance(const IntegratorSettings& settings) {
 		// friction-switch rules this replaces held contacts in tension and
 		// created energy (a stiff pile gained up to 36%).
 		iterate_.assign(n, Vector12::Zero());
+		keptTerms_.clear();
+		keptTermsOf_.assign(contacts.size(), -1);
 		for (Contact& contact : contacts) {
 			startTrial(contact, steps_ == 0);
 			const int bi = contact.key.blockI, bj = contact.key.blockJ;

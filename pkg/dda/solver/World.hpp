@@ -84,10 +84,16 @@ public:
 	// The broad phase (DESSCollider unless set).
 	void setCollider(std::unique_ptr<Collider> collider);
 	const Collider& collider() const { return *collider_; }
-	// Whether the coupled system keeps its sparse components' analyses
-	// between solves (on by default; the results are bitwise the same, see
-	// CoupledSystem.hpp; off for tests).
-	void setAnalysisReuse(bool reuse) { coupled_.setAnalysisReuse(reuse); }
+	// Whether the solver keeps work between solves: the sparse components'
+	// analyses (CoupledSystem.hpp) and, within an attempt, the terms of
+	// contacts that neither slip nor carry a secant force (keptTerms_); and
+	// whether the line search skips the evaluations whose sign is certain
+	// (searchLine). On by default; the results are bitwise the same (off for
+	// tests).
+	void setSolverReuse(bool reuse) {
+		coupled_.setAnalysisReuse(reuse);
+		keepTerms_ = reuse;
+	}
 	// Half the largest extent of the bounding box of all blocks [m] (Shi's w0),
 	// measured at the first step after blocks were added.
 	double sceneHalfSize();
@@ -139,6 +145,37 @@ private:
 	void solveAloneBlocks(const IntegratorSettings& settings, double dt);
 	// Adds the trial-state terms of every contact to coupled_ (counted in stats).
 	void assembleContacts(StepStatistics& stats);
+	// Within an attempt a contact's Newton terms (contactTerms) depend on its
+	// state alone unless it slips or carries a secant force: the normal
+	// spring's on the start-of-step linearisation, the stick spring's on the
+	// anchors, neither of which moves before the attempt ends. So the terms
+	// of such a contact are kept (keptTerms_, up to kKeptTermsBytes in
+	// World.cpp) with the state they were made for (keptTermsKey_: whether
+	// it has normal terms, its tangential term), and added again while it
+	// keeps that state: the same numbers, added in the same order. Cleared
+	// at each attempt's start.
+	//
+	// Why the key is all they depend on: contactTerms reads the contact's
+	// linearisation (normal.ei, ej, d0, valid), stiffnesses, geometry.normal,
+	// gamma and weights (set by prepareContact before the attempts), the
+	// anchors (set by startTrial at the attempt's start, moved only after the
+	// accepted solve), the blocks' centroids (moved after it too), and which
+	// terms the state asks for (hasNormalTerms, tangentialTerm: the key).
+	// Besides these, only a slipping contact's terms read its stretch and
+	// limit, and only the secant's (secantWeight > 0, gamma < 1) read the
+	// trial gap and the bond, both of which change from solve to solve; such
+	// contacts are never kept. (Keying the secant's on its trial gap as well
+	// would be correct but useless: the gap is that of the last solve, which
+	// differs at every solve that moves the contact.) Under Shi's scheme
+	// secantWeight is 0 and this is the rule as first written.
+	struct KeptTerms {
+		Matrix24 stiffness;
+		Vector24 force;
+	};
+	std::vector<KeptTerms> keptTerms_;
+	std::vector<int> keptTermsOf_;             // per contact: its entry of keptTerms_, -1 if none
+	std::vector<unsigned char> keptTermsKey_;  // per contact: the state its kept terms are for
+	bool keepTerms_ = true;
 	// Adds the accepted step's dissipation, work of loads and contact springs'
 	// changes to the account (energy_), and records the springs' energy at its
 	// end; called before the contacts and blocks are moved.
@@ -231,8 +268,8 @@ private:
 	std::vector<Vector12> solutions_;  // the last Newton solution, per moving block
 	std::vector<Vector12> iterate_;    // the current iterate of the step's iteration
 	std::vector<Vector12> deltas_;     // lineSearch's work arrays
-	std::vector<ContactLine> lines_;
-	std::vector<int> groupRoot_, lineGroup_, groupLines_, lineOrder_;
+	std::vector<ContactLine> lines_, orderedLines_;  // per contact; the searched groups' lines, group by group
+	std::vector<int> groupRoot_, lineGroup_, groupLines_;
 	std::vector<char> groupKink_;
 	std::vector<double> groupSlope_, groupCurvature_, groupStep_;
 	// This attempt's own systems of the blocks coupled at some build
