@@ -7,6 +7,7 @@
 // dda::InputError (a std::invalid_argument) -> ValueError, std::out_of_range ->
 // IndexError, anything else -> RuntimeError.
 #include "SceneLink.hpp"
+#include "dda/collider/ColliderFactory.hpp"
 #include "dda/collider/MSCCollider.hpp"
 #include "dda/solver/InitialOverlaps.hpp"
 
@@ -228,16 +229,9 @@ py::list initialOverlaps(SceneLink& s, int firstUnchecked, const py::object& add
 }
 
 void setCollider(SceneLink& s, const std::string& name) {
-	if (name == "DESS")
-		s.world.setCollider(std::make_unique<DESSCollider>());
-	else if (name == "NBS")
-		s.world.setCollider(std::make_unique<NBSCollider>());
-	else if (name == "AllPairs")
-		s.world.setCollider(std::make_unique<AllPairsCollider>());
-	else if (name == "MSC")
-		s.world.setCollider(std::make_unique<MSCCollider>());
-	else
-		throw InputError("unknown collider '" + name + "' (known: DESS, NBS, AllPairs, MSC)");
+	std::unique_ptr<Collider> collider = makeCollider(name);
+	if (!collider) throw InputError("unknown collider '" + name + "' (known: " + colliderList() + ")");
+	s.world.setCollider(std::move(collider));
 }
 std::string colliderName(const SceneLink& s) { return s.world.collider().name(); }
 
@@ -336,6 +330,12 @@ py::dict lastStep(const SceneLink& s) {
 	return d;
 }
 
+py::tuple pythonColliderNames() {
+	py::list names;
+	for (const std::string& name : colliderNames()) names.append(name);
+	return py::tuple(names);
+}
+
 py::object bodyToBlock(const SceneLink& s, int bodyId) {
 	const int block = s.blockOfBody(bodyId);
 	return block < 0 ? py::object() : py::object(block);
@@ -362,6 +362,7 @@ BOOST_PYTHON_MODULE(_core) {
 	        "Raises ValueError naming the problem if the points and material cannot make a DDA block.");
 
 	py::scope().attr("mscMaxSegments") = MSCCollider::kMaxSegments;
+	py::def("colliderNames", &pythonColliderNames, "The broad phases of the core, by name (DESS first, the default).");
 
 	py::class_<IntegratorSettings>("IntegratorSettings", "Parameters of one DDA step (see DDAIntegrator for units and meaning).")
 	    .def_readwrite("maxTimeStep", &IntegratorSettings::maxTimeStep)

@@ -54,7 +54,7 @@ class _Parameter:
         engine._updateCommand()
 
 
-_COLLIDERS = ('DESS', 'NBS', 'AllPairs', 'MSC')
+_COLLIDERS = tuple(_core.colliderNames())   # the core's broad phases (pkg/dda/collider/ColliderFactory.cpp)
 
 
 _INT_MAX = 2 ** 31 - 1   # the core's counters are C ints
