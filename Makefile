@@ -8,7 +8,7 @@ DEB_PACKAGES := yade cmake g++ make libeigen3-dev libcgal-dev libgmp-dev libmpfr
                 libgtest-dev
 SITE_DIR := $(shell $(PYTHON) -c "import sysconfig;print(sysconfig.get_path('purelib','posix_local'))" 2>/dev/null)
 
-.PHONY: deps build install demo test test-hard test-cpp test-py bench bench-pile200 fingerprints regress regress-quick regress-run fuzz mutations clean
+.PHONY: deps build install demo test test-hard test-cpp test-py bench bench-pile200 fingerprints docs regress regress-quick regress-run fuzz mutations clean
 
 deps:
 	@missing=$$(for p in $(DEB_PACKAGES); do dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null | grep -q 'install ok installed' || echo $$p; done); \
@@ -57,6 +57,12 @@ bench: install
 # on one core, so not in `bench`.
 bench-pile200: install
 	$(PYTHON) bench/energy.py --pile200 --threads 1
+
+# The parameter reference doc/parameters.md, generated from the settings' one declaration
+# (pkg/dda/solver/Settings.def) through the built module by tools/gen_docs.py;
+# tests/py/test_parameter_reference.py fails when it is stale.
+docs: build
+	YADE_DDA_BUILD=$(abspath $(BUILD))/py $(PYTHON) tools/gen_docs.py
 
 # Step-by-step fingerprints of every regression and paper scene (bench/out/fingerprints.json), for a
 # refactor that must leave them bitwise: compare with bench/fingerprints.py --compare A B. About 2 minutes.

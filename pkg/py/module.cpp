@@ -7,6 +7,7 @@
 // dda::InputError (a std::invalid_argument) -> ValueError, std::out_of_range ->
 // IndexError, anything else -> RuntimeError.
 #include "SceneLink.hpp"
+#include "dda/collider/ColliderFactory.hpp"
 #include "dda/collider/MSCCollider.hpp"
 #include "dda/solver/InitialOverlaps.hpp"
 
@@ -228,16 +229,9 @@ py::list initialOverlaps(SceneLink& s, int firstUnchecked, const py::object& add
 }
 
 void setCollider(SceneLink& s, const std::string& name) {
-	if (name == "DESS")
-		s.world.setCollider(std::make_unique<DESSCollider>());
-	else if (name == "NBS")
-		s.world.setCollider(std::make_unique<NBSCollider>());
-	else if (name == "AllPairs")
-		s.world.setCollider(std::make_unique<AllPairsCollider>());
-	else if (name == "MSC")
-		s.world.setCollider(std::make_unique<MSCCollider>());
-	else
-		throw InputError("unknown collider '" + name + "' (known: DESS, NBS, AllPairs, MSC)");
+	std::unique_ptr<Collider> collider = makeCollider(name);
+	if (!collider) throw InputError("unknown collider '" + name + "' (known: " + colliderList() + ")");
+	s.world.setCollider(std::move(collider));
 }
 std::string colliderName(const SceneLink& s) { return s.world.collider().name(); }
 
@@ -336,6 +330,70 @@ py::dict lastStep(const SceneLink& s) {
 	return d;
 }
 
+// _core.settingsTable(): one dict per row of Settings.def, in its order, from
+// which yade_dda.engines makes DDAIntegrator's parameters, their checks and
+// docstring, and tools/gen_docs.py doc/parameters.md.
+const char* kindOf(double) { return "real"; }
+const char* kindOf(int) { return "integer"; }
+const char* kindOf(bool) { return "boolean"; }
+const char* kindOf(const Vector3&) { return "vector"; }
+const char* kindOf(const std::string&) { return "choice"; }
+
+template <class T>
+py::object toPython(const T& value) {
+	return py::object(value);
+}
+py::object toPython(const Vector3& value) { return py::make_tuple(value.x(), value.y(), value.z()); }
+
+void describe(py::dict& row, const Range& range, bool integer) {
+	row["low"] = range.low;
+	row["high"] = range.high;
+	row["lowOpen"] = range.lowOpen;
+	row["highOpen"] = range.highOpen;
+	row["range"] = range.text(integer);
+}
+void describe(py::dict& row, const std::vector<std::string>& choices, bool) {
+	py::list names;
+	std::string text;
+	for (const std::string& name : choices) {
+		names.append(name);
+		text += (text.empty() ? "one of " : ", ") + name;
+	}
+	row["choices"] = py::tuple(names);
+	row["range"] = text;
+}
+
+template <class T, class Allowed>
+py::dict settingRow(const char* name, const char* member, const T& value, const Allowed& allowed, const char* unit,
+                    const char* doc) {
+	py::dict row;
+	row["name"] = name;
+	row["member"] = member ? py::object(member) : py::object();
+	row["kind"] = kindOf(value);
+	row["default"] = toPython(value);
+	describe(row, allowed, std::is_same<T, int>::value);
+	row["unit"] = unit;
+	row["doc"] = doc;
+	return row;
+}
+
+py::tuple settingsTable() {
+	const IntegratorSettings defaults;
+	py::list rows;
+#define DDA_SETTING(type, name, engineName, value, range, unit, doc) \
+	rows.append(settingRow(#engineName, #name, defaults.name, range, unit, doc));
+#define DDA_ENGINE_SETTING(type, name, value, range, unit, doc) \
+	rows.append(settingRow(#name, nullptr, type(value), range, unit, doc));
+#include "dda/solver/Settings.def"
+	return py::tuple(rows);
+}
+
+py::tuple pythonColliderNames() {
+	py::list names;
+	for (const std::string& name : colliderNames()) names.append(name);
+	return py::tuple(names);
+}
+
 py::object bodyToBlock(const SceneLink& s, int bodyId) {
 	const int block = s.blockOfBody(bodyId);
 	return block < 0 ? py::object() : py::object(block);
@@ -363,29 +421,17 @@ BOOST_PYTHON_MODULE(_core) {
 
 	py::scope().attr("mscMaxSegments") = MSCCollider::kMaxSegments;
 
-	py::class_<IntegratorSettings>("IntegratorSettings", "Parameters of one DDA step (see DDAIntegrator for units and meaning).")
-	    .def_readwrite("maxTimeStep", &IntegratorSettings::maxTimeStep)
-	    .def_readwrite("gravity", &IntegratorSettings::gravity)
-	    .def_readwrite("velocityRatio", &IntegratorSettings::velocityRatio)
-	    .def_readwrite("newmarkBeta", &IntegratorSettings::newmarkBeta)
-	    .def_readwrite("newmarkGamma", &IntegratorSettings::newmarkGamma)
-	    .def_readwrite("startFromRest", &IntegratorSettings::startFromRest)
-	    .def_readwrite("maxDisplacement", &IntegratorSettings::maxDisplacement)
-	    .def_readwrite("maxDisplacementRatio", &IntegratorSettings::maxDisplacementRatio)
-	    .def_readwrite("timeStepSafety", &IntegratorSettings::timeStepSafety)
-	    .def_readwrite("minTimeStepShrink", &IntegratorSettings::minTimeStepShrink)
-	    .def_readwrite("maxTimeStepShrink", &IntegratorSettings::maxTimeStepShrink)
-	    .def_readwrite("timeStepGrowth", &IntegratorSettings::timeStepGrowth)
-	    .def_readwrite("maxStepCuts", &IntegratorSettings::maxStepCuts)
-	    .def_readwrite("fixedPointPenaltyFactor", &IntegratorSettings::fixedPointPenaltyFactor)
-	    .def_readwrite("contactDistance", &IntegratorSettings::contactDistance)
-	    .def_readwrite("contactDistanceFactor", &IntegratorSettings::contactDistanceFactor)
-	    .def_readwrite("contactPenaltyFactor", &IntegratorSettings::contactPenaltyFactor)
-	    .def_readwrite("shearStiffnessRatio", &IntegratorSettings::shearStiffnessRatio)
-	    .def_readwrite("maxOpenCloseIterations", &IntegratorSettings::maxOpenCloseIterations)
-	    .def_readwrite("openCloseShrink", &IntegratorSettings::openCloseShrink)
-	    .def_readwrite("threads", &IntegratorSettings::threads)
-	    .def_readwrite("reuseCandidatePairs", &IntegratorSettings::reuseCandidatePairs);
+	py::def("settingsTable", &settingsTable,
+	        "Every DDAIntegrator parameter, one dict per row of pkg/dda/solver/Settings.def: name, member (the "
+	        "IntegratorSettings attribute; None for the engine's own), kind, default, range (its text), low, high, "
+	        "lowOpen, highOpen (numbers) or choices (names), unit, doc.");
+	py::def("colliderNames", &pythonColliderNames, "The broad phases of the core, by name (DESS first, the default).");
+
+	py::class_<IntegratorSettings> settingsClass(
+	    "IntegratorSettings", "Parameters of one DDA step (pkg/dda/solver/Settings.def; DDAIntegrator's docstring).");
+#define DDA_SETTING(type, name, engineName, value, range, unit, doc) \
+	settingsClass.def_readwrite(#name, &IntegratorSettings::name, doc);
+#include "dda/solver/Settings.def"
 
 	py::class_<SceneLink, boost::noncopyable>("Scene", "The DDA state of one YADE scene; the core is the source of truth.")
 	    .def("addBlock", &addBlock,

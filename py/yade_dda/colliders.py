@@ -199,5 +199,5 @@ def available():
     return tuple(_engines._COLLIDERS)
 
 
-ENGINES = {'MSC': MSCCollider, 'DESS': DESSCollider, 'NBS': NBSCollider, 'AllPairs': AllPairsCollider}
+ENGINES = {engine._strategy: engine for engine in (MSCCollider, DESSCollider, NBSCollider, AllPairsCollider)}
 """Collider engine class of each strategy name."""

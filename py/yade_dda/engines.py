@@ -8,6 +8,7 @@ The command string carries every parameter, so an engine that comes back from
 import ast
 import math
 import sys
+import textwrap
 import time
 
 from ._yade import O, wrapper
@@ -17,7 +18,10 @@ from . import scene as _scene
 from .blocks import _vector
 
 
-def _finite(name, value, low=None, high=None, lowOpen=False, unit=''):
+def _finite(name, value, low=None, high=None, lowOpen=False, unit='', highOpen=False, bounds=None):
+    """float(value) if it is finite and in the range from low to high (None: unbounded;
+    lowOpen, highOpen: that end excluded); else TypeError or ValueError naming the
+    parameter, the range (bounds: its text, by default made from the ends) and the value."""
     if isinstance(value, bool):
         raise TypeError('%s must be a number, got %r' % (name, value))
     try:
@@ -28,9 +32,11 @@ def _finite(name, value, low=None, high=None, lowOpen=False, unit=''):
     if ok and low is not None:
         ok = value > low if lowOpen else value >= low
     if ok and high is not None:
-        ok = value <= high
+        ok = value < high if highOpen else value <= high
     if not ok:
-        bounds = '%s%s, %s]' % ('(' if lowOpen else '[', low, high if high is not None else 'inf')
+        if bounds is None:
+            bounds = '%s%s, %s' % ('(' if lowOpen else '[', low, '%s%s' % (high, ')' if highOpen else ']')
+                                   if high is not None else 'inf)')
         raise ValueError('%s must be finite and in %s, got %r%s' % (name, bounds, value, unit))
     return value
 
@@ -44,6 +50,13 @@ class _Parameter:
     def __set_name__(self, owner, name):
         self.name = name
 
+    @classmethod
+    def fromRow(cls, row):
+        """The parameter of a row of _core.settingsTable() (pkg/dda/solver/Settings.def)."""
+        parameter = cls(row['default'], _check(row), row['doc'])
+        parameter.name = row['name']
+        return parameter
+
     def __get__(self, engine, owner=None):
         if engine is None:
             return self
@@ -54,27 +67,48 @@ class _Parameter:
         engine._updateCommand()
 
 
-_COLLIDERS = ('DESS', 'NBS', 'AllPairs', 'MSC')
+_COLLIDERS = tuple(_core.colliderNames())   # the core's broad phases (pkg/dda/collider/ColliderFactory.cpp)
 
 
 _INT_MAX = 2 ** 31 - 1   # the core's counters are C ints
 
 
-def _integer(name, low, high=_INT_MAX):
+def _integer(name, low, high=_INT_MAX, bounds=None):
     """Validator of an integer parameter in [low, high]; rejects 1.5, '3', True."""
     def check(value):
         if isinstance(value, bool) or not isinstance(value, (int, float)) or value != int(value):
             raise TypeError('%s must be an integer, got %r' % (name, value))
         if not low <= value <= high:
-            raise ValueError('%s must be an integer in [%d, %d], got %r' % (name, low, high, value))
+            raise ValueError('%s must be an integer in %s, got %r' % (name, bounds or '[%d, %d]' % (low, high), value))
         return int(value)
     return check
 
 
-def _colliderName(value):
-    if value not in _COLLIDERS:
-        raise ValueError('collider must be one of %s, got %r' % (', '.join(_COLLIDERS), value))
-    return value
+def _choice(name, choices):
+    def check(value):
+        if value not in choices:
+            raise ValueError('%s must be one of %s, got %r' % (name, ', '.join(choices), value))
+        return value
+    return check
+
+
+def _check(row):
+    """The validator of a row of _core.settingsTable(), by its kind; the range and its
+    text come from the row."""
+    name, kind = row['name'], row['kind']
+    if kind == 'real':
+        unit = '' if row['unit'] in ('', '-') else ' ' + row['unit']
+        return lambda value: _finite(name, value, row['low'], row['high'], row['lowOpen'], unit, row['highOpen'],
+                                     row['range'])
+    if kind == 'integer':
+        return _integer(name, max(row['low'], -_INT_MAX - 1), min(row['high'], _INT_MAX), row['range'])
+    if kind == 'boolean':
+        return bool
+    if kind == 'vector':
+        return _vector3(name)
+    if kind == 'choice':
+        return _choice(name, row['choices'])
+    raise TypeError('setting %s has an unknown kind %r' % (name, kind))
 
 
 def _initEngine(engine, label, params):
@@ -104,8 +138,29 @@ def _vector3(name):
     return lambda value: _vector(value, name)
 
 
-class DDAIntegrator(wrapper.PyRunner):
-    """Shi's implicit DDA time integration of all DDA blocks, with their contacts
+_SETTINGS = _core.settingsTable()
+"""Every DDAIntegrator parameter, from the core's one declaration of the settings
+(pkg/dda/solver/Settings.def): dicts with name, member (the IntegratorSettings
+attribute, None for the engine's own), kind, default, range (and low, high,
+lowOpen, highOpen or choices), unit, doc."""
+
+
+RULES = '``newmarkBeta = newmarkGamma / 2``, ``minTimeStepShrink <= maxTimeStepShrink``'
+"""The rules between settings that validateSettings (pkg/dda/solver/Settings.cpp) checks at each step."""
+
+
+def parameterLine(row):
+    """'``dt`` [s], default 0.001, in (0, inf): largest time step; ...' for docstrings."""
+    unit = ' [%s]' % row['unit'] if row['unit'] else ''
+    where = ''
+    if row['kind'] in ('real', 'integer'):
+        where = ', in %s' % row['range']
+    elif row['kind'] == 'choice':
+        where = ', %s' % row['range']
+    return '``%s``%s, default %r%s: %s' % (row['name'], unit, row['default'], where, row['doc'])
+
+
+_INTEGRATOR_DOC = """Shi's implicit DDA time integration of all DDA blocks, with their contacts
     (replaces NewtonIntegrator, and YADE's collider and contact laws).
 
     Each step solves, for the 12 unknowns D of every moving block
@@ -124,113 +179,23 @@ class DDAIntegrator(wrapper.PyRunner):
     exceeds the allowed one is redone with a smaller dt. ``O.dt`` and
     ``O.time`` follow the step actually taken.
 
-    Parameters (SI units):
+    Parameters (SI units; generated from pkg/dda/solver/Settings.def, as is
+    doc/parameters.md). Each is checked against its range when set; the rules
+    between them (%s) when the engine steps.
 
-    - ``dt`` [s]: largest time step, > 0.
-    - ``gravity`` [m/s^2]: body acceleration.
-    - ``velocityRatio`` [-]: Shi's dynamic coefficient in [0, 1]; 1 is fully
-      dynamic, 0 static analysis (velocities reset every step).
-    - ``newmarkBeta``, ``newmarkGamma`` [-]: the member of Newmark's family
-      (``D = v0 dt + dt^2 ((1/2 - beta) a0 + beta a1)``, ``v1 = v0 + dt ((1 -
-      gamma) a0 + gamma a1)``). Default 1/2 and 1: Shi's scheme, which damps
-      high frequencies (a bounce loses energy, contacts stop ringing within a
-      step or two). 1/4 and 1/2: average acceleration, second order, keeps
-      the energy of an elastic bounce (contacts take the secant force whose
-      work is exactly minus their spring energy's change). Accepted: 1/2 <=
-      gamma <= 1 and beta = gamma/2 (positions by the trapezoidal rule:
-      every such member dissipates 2 gamma - 1 times the Bregman divergence
-      of the elastic and contact energies, so none creates energy; checked
-      when the engine steps).
-    - ``startFromRest`` (True): before the first step, blocks at rest that
-      touch (through contacts) a fixed block or a fixed point are brought to
-      static equilibrium under gravity, loads and stresses, every touching
-      contact held by its springs with friction locked; the dynamics starts
-      from there, contacts loaded, velocities zero (``stats()['settleSteps']``,
-      ``'settledBlocks'``, ``'settleConverged'``; a scene without such an
-      equilibrium, e.g. a block on a frictionless slope, starts as placed).
-      False: start as placed, contacts unloaded.
-    - ``maxDisplacement`` [m]: largest vertex displacement per step; 0 means
-      ``maxDisplacementRatio`` x half the largest extent of the scene.
-    - ``maxDisplacementRatio`` [-]: Shi's g2, default 0.01.
-    - ``timeStepGrowth`` [-]: after an accepted step the next one tries dt x this.
-    - ``maxStepCuts``: redos allowed per step before a step is accepted anyway
-      (counted in ``stats()['displacementLimitMisses']``).
-    - ``fixedPointPenaltyFactor`` [-]: default fixed-point stiffness is this x E x
-      block size (cube root of the volume).
-    - ``threads``: worker threads for the core, 0 = all; results do not depend on it.
-    - ``contactDistance`` [m]: d0, within which features become contacts; 0
-      (default) = 2.5 x the allowed step displacement (Shi's rule).
-    - ``contactPenaltyFactor`` [-]: normal contact stiffness [N/m] is this x
-      the smaller E x size of the two blocks (default 40; Shi: 40-100 x E).
-    - ``shearStiffnessRatio`` [-]: shear / normal contact stiffness (0.4).
-    - ``maxOpenCloseIterations``: solves per step before dt is cut (40;
-      the iteration makes passes with fixed friction limits, see README).
-    - ``openCloseShrink`` [-]: dt factor for a step whose iteration did not
-      converge (0.3).
-    - ``collider``: the broad phase, ``'MSC'`` (multi-shell cover, with its
-      default cover; use ``MSCCollider`` to set lambda and N), ``'DESS'`` (one
-      sorted box per block, default), ``'NBS'`` (one bounding sphere per
-      block, binned in cells) or
-      ``'AllPairs'`` (every pair: the reference, O(n^2)). All give the same
-      contacts; only the time differs. A collider engine before the
-      integrator (``DESSCollider``, ``NBSCollider``, ...) overrides it.
-    - ``reuseCandidatePairs``: diagnostic; True (default) lets the DESS
-      and MSC broad phases reuse their candidate (MSC: shell) pairs while no
-      block has moved past its allowance (d0 per box side), False searches
-      every step. The
-      contacts are the same either way (``stats()['broadPhaseSkipped']``
-      counts the skipped searches); False exists to measure what the cache
-      saves.
-    - ``syncPeriod``: write the DDA state into YADE's bodies every n steps; 0
-      (default) = when something may read it: the last step of ``O.run(n)``,
-      ``O.step()``, a step after which another periodic engine (a PyRunner
-      recorder, VTK export, ...) is due, or an open GUI view.
+%s
 
     Example::
 
         O.engines = [DDAIntegrator(dt=1e-3, gravity=(0, 0, -9.81), label='dda')]
         O.run(1000, True)
-    """
+    """ % (RULES, '\n'.join(textwrap.fill(parameterLine(row), 79, initial_indent='    - ', subsequent_indent='      ')
+                               for row in _SETTINGS))
 
-    dt = _Parameter(1e-3, lambda v: _finite('dt', v, 0, lowOpen=True, unit=' s'), 'largest time step [s]')
-    gravity = _Parameter((0.0, 0.0, 0.0), _vector3('gravity'), 'body acceleration [m/s^2]')
-    velocityRatio = _Parameter(1.0, lambda v: _finite('velocityRatio', v, 0, 1), "Shi's dynamic coefficient [-]")
-    newmarkBeta = _Parameter(0.5, lambda v: _finite('newmarkBeta', v, 0.25, 0.5),
-                             "Newmark's beta [-]: 1/2 with gamma 1 is Shi's scheme, 1/4 with gamma 1/2 average acceleration")
-    newmarkGamma = _Parameter(1.0, lambda v: _finite('newmarkGamma', v, 0.5, 1), "Newmark's gamma [-]")
-    startFromRest = _Parameter(True, lambda v: bool(v),
-                               'bring touching blocks at rest to static equilibrium before the first step')
-    maxDisplacement = _Parameter(0.0, lambda v: _finite('maxDisplacement', v, 0, unit=' m'),
-                                 'largest vertex displacement per step [m]; 0 = use maxDisplacementRatio')
-    maxDisplacementRatio = _Parameter(0.01, lambda v: _finite('maxDisplacementRatio', v, 0, 1, lowOpen=True),
-                                      'allowed displacement / half scene size [-]')
-    timeStepGrowth = _Parameter(1.3, lambda v: _finite('timeStepGrowth', v, 1), 'dt growth after a step [-]')
-    maxStepCuts = _Parameter(30, _integer('maxStepCuts', 0), 'redos allowed per step')
-    fixedPointPenaltyFactor = _Parameter(1000.0, lambda v: _finite('fixedPointPenaltyFactor', v, 0, lowOpen=True),
-                                         'default fixed-point stiffness / (E x block size) [-]')
-    threads = _Parameter(0, _integer('threads', 0), 'core threads, 0 = all')
-    syncPeriod = _Parameter(0, _integer('syncPeriod', 0), 'steps between syncs, 0 = automatic')
-    contactDistance = _Parameter(0.0, lambda v: _finite('contactDistance', v, 0, unit=' m'),
-                                 'contact distance d0 [m]; 0 = 2.5 x allowed step displacement')
-    contactPenaltyFactor = _Parameter(40.0, lambda v: _finite('contactPenaltyFactor', v, 0, lowOpen=True),
-                                      'contact normal stiffness / min(E x block size) [-]')
-    shearStiffnessRatio = _Parameter(0.4, lambda v: _finite('shearStiffnessRatio', v, 0),
-                                     'contact shear / normal stiffness [-]')
-    maxOpenCloseIterations = _Parameter(40, _integer('maxOpenCloseIterations', 1),
-                                        'open-close iterations before dt is cut')
-    openCloseShrink = _Parameter(0.3, lambda v: _finite('openCloseShrink', v, 0, 0.99, lowOpen=True),
-                                 'dt factor when the open-close iteration does not converge [-]')
-    collider = _Parameter('DESS', lambda v: _colliderName(v),
-                          "broad phase: 'MSC' (multi-shell cover), 'DESS' (sorted boxes, default), 'NBS' (binned spheres) or "
-                          "'AllPairs' (every pair, the oracle)")
-    reuseCandidatePairs = _Parameter(True, lambda v: bool(v),
-                                     'diagnostic: reuse broad-phase candidate pairs while blocks rest (same contacts)')
 
-    _names = ('dt', 'gravity', 'velocityRatio', 'newmarkBeta', 'newmarkGamma', 'startFromRest', 'maxDisplacement', 'maxDisplacementRatio', 'timeStepGrowth',
-              'maxStepCuts', 'fixedPointPenaltyFactor', 'threads', 'syncPeriod', 'contactDistance',
-              'contactPenaltyFactor', 'shearStiffnessRatio', 'maxOpenCloseIterations', 'openCloseShrink',
-              'collider',
-              'reuseCandidatePairs')
+class DDAIntegrator(wrapper.PyRunner):
+    __doc__ = _INTEGRATOR_DOC
+    _names = tuple(row['name'] for row in _SETTINGS)
 
     def __init__(self, label='', **params):
         wrapper.PyRunner.__init__(self)
@@ -248,6 +213,10 @@ class DDAIntegrator(wrapper.PyRunner):
         self.command = 'import yade_dda.engines as _dda; _dda.integratorStep(%r)' % (repr(changed),)
 
 
+for _row in _SETTINGS:
+    setattr(DDAIntegrator, _row['name'], _Parameter.fromRow(_row))
+
+
 _paramsCache = {}
 
 
@@ -263,24 +232,9 @@ def _parse(text):
 
 def _settings(params):
     settings = _core.IntegratorSettings()
-    settings.maxTimeStep = params['dt']
-    settings.gravity = params['gravity']
-    settings.velocityRatio = params['velocityRatio']
-    settings.newmarkBeta = params['newmarkBeta']
-    settings.startFromRest = params['startFromRest']
-    settings.newmarkGamma = params['newmarkGamma']
-    settings.maxDisplacement = params['maxDisplacement']
-    settings.maxDisplacementRatio = params['maxDisplacementRatio']
-    settings.timeStepGrowth = params['timeStepGrowth']
-    settings.maxStepCuts = params['maxStepCuts']
-    settings.fixedPointPenaltyFactor = params['fixedPointPenaltyFactor']
-    settings.threads = params['threads']
-    settings.contactDistance = params['contactDistance']
-    settings.contactPenaltyFactor = params['contactPenaltyFactor']
-    settings.shearStiffnessRatio = params['shearStiffnessRatio']
-    settings.maxOpenCloseIterations = params['maxOpenCloseIterations']
-    settings.openCloseShrink = params['openCloseShrink']
-    settings.reuseCandidatePairs = params['reuseCandidatePairs']
+    for row in _SETTINGS:
+        if row['member'] is not None:
+            setattr(settings, row['member'], params[row['name']])
     return settings
 
 

@@ -3,6 +3,7 @@
 // whose narrow phase finds a contact, so all of them end with exactly the
 // contact set of AllPairsCollider.
 #include "dda/collider/Collider.hpp"
+#include "dda/collider/ColliderFactory.hpp"
 #include "dda/collider/MSCCollider.hpp"
 #include "dda/contact/PairDetection.hpp"
 #include "dda/solver/World.hpp"
@@ -75,4 +76,11 @@ TEST(Colliders, FixedPairsAreNeverProposed) {
 		const std::vector<std::pair<int, int>> expected{{0, 2}, {1, 2}};
 		EXPECT_EQ(pairs, expected) << collider->name();
 	}
+}
+
+TEST(Colliders, EveryColliderIsMadeByItsName) {
+	ASSERT_EQ(colliderNames(), (std::vector<std::string>{"DESS", "NBS", "AllPairs", "MSC"}));
+	for (const std::string& name : colliderNames()) EXPECT_EQ(makeCollider(name)->name(), name);
+	EXPECT_EQ(makeCollider("Octree"), nullptr);
+	EXPECT_EQ(colliderList(), "DESS, NBS, AllPairs, MSC");
 }

@@ -171,8 +171,8 @@ def test_bad_block_arguments(scene, kw, error, match):
 # ------------------------------------------------------------------ engine parameters
 
 @pytest.mark.parametrize('kw, error, match', [
-    (dict(dt=0), ValueError, r'dt must be finite and in \(0, inf\], got 0.0 s'),
-    (dict(dt=-1e-3), ValueError, r'dt must be finite and in \(0, inf\]'),
+    (dict(dt=0), ValueError, r'dt must be finite and in \(0, inf\), got 0.0 s'),
+    (dict(dt=-1e-3), ValueError, r'dt must be finite and in \(0, inf\)'),
     (dict(dt=float('nan')), ValueError, r'dt must be finite'),
     (dict(dt='fast'), TypeError, r"dt must be a number, got 'fast'"),
     (dict(dt=None), TypeError, r'dt must be a number, got None'),
@@ -180,10 +180,10 @@ def test_bad_block_arguments(scene, kw, error, match):
     (dict(gravity=(0, 0)), ValueError, r'gravity must have 3 components, got 2'),
     (dict(velocityRatio=1.5), ValueError, r'velocityRatio must be finite and in \[0, 1\]'),
     (dict(maxDisplacementRatio=0), ValueError, r'maxDisplacementRatio must be finite and in \(0, 1\]'),
-    (dict(timeStepGrowth=0.5), ValueError, r'timeStepGrowth must be finite and in \[1, inf\]'),
-    (dict(contactDistance=-1), ValueError, r'contactDistance must be finite and in \[0, inf\], got -1.0 m'),
-    (dict(contactPenaltyFactor=0), ValueError, r'contactPenaltyFactor must be finite and in \(0, inf\]'),
-    (dict(openCloseShrink=1), ValueError, r'openCloseShrink must be finite and in \(0, 0.99\]'),
+    (dict(timeStepGrowth=0.5), ValueError, r'timeStepGrowth must be finite and in \[1, inf\)'),
+    (dict(contactDistance=-1), ValueError, r'contactDistance must be finite and in \[0, inf\), got -1.0 m'),
+    (dict(contactPenaltyFactor=0), ValueError, r'contactPenaltyFactor must be finite and in \(0, inf\)'),
+    (dict(openCloseShrink=1), ValueError, r'openCloseShrink must be finite and in \(0, 1\)'),
     (dict(threads=1.5), TypeError, r'threads must be an integer, got 1.5'),
     (dict(threads=-1), ValueError, r'threads must be an integer in \[0, 2147483647\], got -1'),
     (dict(maxOpenCloseIterations=1e30), ValueError, r'maxOpenCloseIterations must be an integer in \[1, 2147483647\]'),
@@ -209,7 +209,7 @@ def test_bad_parameter_assigned_to_a_running_integrator_keeps_the_old_value(scen
     (dict(segments=65), ValueError, r'segments must be an integer in \[1, 64\], got 65'),
     (dict(segments=2.5), ValueError, r'segments must be an integer >= 1, got 2.5'),
     (dict(segments=None), ValueError, r'segments must be an integer >= 1, got None'),
-    (dict(criticalLength=-1), ValueError, r'criticalLength must be finite and in \[0, inf\], got -1.0 m'),
+    (dict(criticalLength=-1), ValueError, r'criticalLength must be finite and in \[0, inf\), got -1.0 m'),
     (dict(criticalLength=float('inf')), ValueError, r'criticalLength must be finite'),
 ], ids=['0 segments', '65 segments', 'fractional segments', 'None segments', 'negative lambda', 'infinite lambda'])
 def test_bad_msc_parameters(scene, kw, error, match):

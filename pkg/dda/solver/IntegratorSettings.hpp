@@ -2,98 +2,19 @@
 #pragma once
 
 #include "dda/block/Displacement.hpp"
+#include "dda/solver/Settings.hpp"
 
 namespace dda {
 
+// One member per row of Settings.def, with its default; each setting's
+// range, unit and meaning are there. validateSettings (Settings.hpp) checks
+// a whole set.
 struct IntegratorSettings {
-	// Largest time step [s], > 0. The step actually taken may be smaller (see
-	// the displacement bound below); the next step grows back towards it.
-	double maxTimeStep = 1e-3;
-	// Body acceleration [m/s^2]; zero means no body-force assembly at all.
-	Vector3 gravity = Vector3::Zero();
-	// Shi's dynamic coefficient in [0, 1]: the fraction of the end velocity that
-	// carries into the next step. 1 = fully dynamic, 0 = static analysis.
-	double velocityRatio = 1;
-	// The member of Newmark's family the step uses (BlockEquations.hpp):
-	//   D = v0 dt + dt^2 ((1/2 - beta) a0 + beta a1),
-	//   v1 = v0 + dt ((1 - gamma) a0 + gamma a1).
-	// Shi's scheme, beta = 1/2 and gamma = 1, is the default: a constant
-	// acceleration a1 over the step, first order, damping high frequencies
-	// completely (a contact's ringing dies within a step or two). Average
-	// acceleration, beta = 1/4 and gamma = 1/2, is second order and keeps
-	// the energy of a linear system exactly; its contacts take the secant
-	// (discrete-gradient) force, so an elastic bounce keeps its energy too
-	// (ContactEquations.hpp). Accepted: 1/2 <= gamma <= 1 and beta =
-	// gamma/2 (the members whose positions follow the trapezoidal rule;
-	// each dissipates 2 gamma - 1 times the Bregman divergence of the
-	// elastic and contact energies, so none creates energy) [-].
-	double newmarkBeta = 0.5;
-	double newmarkGamma = 1.0;
+#define DDA_SETTING(type, name, engineName, value, range, unit, doc) type name = value;
+#include "dda/solver/Settings.def"
+
 	// Shi's scheme needs no start-of-step acceleration a0.
 	bool shiScheme() const { return newmarkBeta == 0.5 && newmarkGamma == 1.0; }
-	// Largest vertex displacement allowed in one step [m]. When <= 0 it is
-	// maxDisplacementRatio x half the largest extent of the scene's bounding box
-	// (Shi's g2 x w0), measured at the first step after blocks were added.
-	double maxDisplacement = 0;
-	double maxDisplacementRatio = 0.01;  // [-], > 0
-	// A step whose largest displacement d exceeds the allowed a is redone with
-	// dt x clamp(safety x a / d, minShrink, maxShrink). Displacement is at most
-	// linear in dt for the shrink factors used, so one redo usually suffices.
-	double timeStepSafety = 0.9;
-	double minTimeStepShrink = 0.1;
-	double maxTimeStepShrink = 0.9;
-	// After an accepted step the next one tries dt x timeStepGrowth (<= maxTimeStep).
-	double timeStepGrowth = 1.3;
-	// Redo a step at most this many times; a step still too large after that is
-	// accepted and counted in StepStatistics::displacementLimitMisses.
-	int maxStepCuts = 30;
-	// Stiffness of a fixed point's penalty spring when the block's own is not
-	// given: factor x Young's modulus x block size (cube root of volume) [N/m].
-	double fixedPointPenaltyFactor = 1000;
-
-	// ---- contacts (Shi's rules, scaled to the block and the step)
-	// Contact distance d0 [m]: pairs of features closer than this become
-	// (possibly open) contacts. <= 0: contactDistanceFactor x the allowed step
-	// displacement (Shi's d0 = 2.5 x g2 x w0), so no contact can be crossed
-	// within one step unseen.
-	double contactDistance = 0;
-	double contactDistanceFactor = 2.5;  // [-], > 1
-	// Normal penalty stiffness of a sub-contact [N/m]: contactPenaltyFactor x
-	// min(E size) of its two blocks (size = cube root of the volume), so the
-	// penetration under a block's own weight scales like rho g size^2 / (factor E)
-	// whatever the scene's units. Shi recommends 40 to 100 x E (2D).
-	double contactPenaltyFactor = 40;
-	// Shear spring of a locked contact: shearStiffnessRatio x normal stiffness
-	// [-]; 0.4 = G/E of a rock with Poisson's ratio 0.25.
-	double shearStiffnessRatio = 0.4;
-	// Open-close iteration: at most this many solves per step; a step whose
-	// iteration has not converged by then is redone with dt x openCloseShrink
-	// (Shi: 6 and 0.3). The iteration (World::step) makes passes with fixed
-	// friction limits and moves the limits between passes; a settling pile of
-	// 8 cubes with a ninth dropped on it took up to 30 solves in a step, and
-	// a cut wastes the solves already made and shrinks the step, so 40.
-	// Counted in StepStatistics.
-	int maxOpenCloseIterations = 40;
-	double openCloseShrink = 0.3;
-
-	// Start from rest (World::settle): before the first step, the blocks at
-	// rest that touch, through contacts, a fixed block or a fixed point are
-	// brought to static equilibrium under gravity, their loads and stresses
-	// with every touching contact held by its springs (friction locked), and
-	// start the dynamics from there with loaded contacts and zero velocity.
-	// Without it a block laid on a floor starts on unloaded springs: it sinks
-	// and rings, and friction follows the ringing normal force (a pushed
-	// block slid 6.5% too far at dt 1e-4). false: start as placed.
-	bool startFromRest = true;
-
-	// Reuse the broad phase's candidate pairs across steps while no block has
-	// left its Verlet allowance (DESSCollider's cache). The contacts found do
-	// not depend on it; false is a diagnostic for comparing the work saved.
-	bool reuseCandidatePairs = true;
-
-	// Worker threads for per-block work; 0 = OpenMP's default. Results do not
-	// depend on the count.
-	int threads = 0;
 };
 
 // The energy account of a scene [J] (World::energy; Python stats()['energy']).

@@ -303,50 +303,6 @@ double World::sceneHalfSize() {
 	return sceneHalfSize_;
 }
 
-void World::validateSettings(const IntegratorSettings& s) const {
-	std::ostringstream message;
-	if (!(std::isfinite(s.maxTimeStep) && s.maxTimeStep > 0))
-		message << "dt must be positive and finite, got " << s.maxTimeStep << " s";
-	else if (!s.gravity.allFinite())
-		message << "gravity must be finite";
-	else if (!(s.velocityRatio >= 0 && s.velocityRatio <= 1))
-		message << "velocityRatio must lie in [0, 1], got " << s.velocityRatio;
-	else if (!(s.newmarkGamma >= 0.5 && s.newmarkGamma <= 1))
-		message << "newmarkGamma must lie in [0.5, 1] (unconditionally stable, at most first-order damped), got "
-		        << s.newmarkGamma;
-	else if (!(std::abs(s.newmarkBeta - 0.5 * s.newmarkGamma) <= 1e-12))
-		message << "newmarkBeta must be newmarkGamma / 2 (the members whose positions follow the trapezoidal rule, "
-		        << "for which no member creates energy; Shi's scheme is 1/2 and 1, average acceleration 1/4 and "
-		        << "1/2), got " << s.newmarkBeta << " with newmarkGamma " << s.newmarkGamma;
-	else if (!(std::isfinite(s.maxDisplacement)))
-		message << "maxDisplacement must be finite, got " << s.maxDisplacement << " m";
-	else if (!(s.maxDisplacementRatio > 0 && std::isfinite(s.maxDisplacementRatio)))
-		message << "maxDisplacementRatio must be positive, got " << s.maxDisplacementRatio;
-	else if (!(s.minTimeStepShrink > 0 && s.minTimeStepShrink <= s.maxTimeStepShrink && s.maxTimeStepShrink < 1))
-		message << "time-step shrink factors must satisfy 0 < min <= max < 1";
-	else if (!(s.timeStepGrowth >= 1 && std::isfinite(s.timeStepGrowth)))
-		message << "timeStepGrowth must be >= 1, got " << s.timeStepGrowth;
-	else if (s.maxStepCuts < 0)
-		message << "maxStepCuts must be >= 0, got " << s.maxStepCuts;
-	else if (!(s.fixedPointPenaltyFactor > 0 && std::isfinite(s.fixedPointPenaltyFactor)))
-		message << "fixedPointPenaltyFactor must be positive, got " << s.fixedPointPenaltyFactor;
-	else if (!(std::isfinite(s.contactDistance) && s.contactDistance >= 0))
-		message << "contactDistance must be >= 0 and finite, got " << s.contactDistance << " m";
-	else if (!(std::isfinite(s.contactDistanceFactor) && s.contactDistanceFactor >= 1))
-		message << "contactDistanceFactor must be >= 1, got " << s.contactDistanceFactor;
-	else if (!(std::isfinite(s.contactPenaltyFactor) && s.contactPenaltyFactor > 0))
-		message << "contactPenaltyFactor must be positive, got " << s.contactPenaltyFactor;
-	else if (!(std::isfinite(s.shearStiffnessRatio) && s.shearStiffnessRatio >= 0))
-		message << "shearStiffnessRatio must be >= 0, got " << s.shearStiffnessRatio;
-	else if (s.maxOpenCloseIterations < 1)
-		message << "maxOpenCloseIterations must be >= 1, got " << s.maxOpenCloseIterations;
-	else if (!(s.openCloseShrink > 0 && s.openCloseShrink < 1))
-		message << "openCloseShrink must lie in (0, 1), got " << s.openCloseShrink;
-	else
-		return;
-	throw InputError(message.str());
-}
-
 void World::setCollider(std::unique_ptr<Collider> collider) {
 	if (!collider) throw InputError("a collider is required");
 	collider_ = std::move(collider);

@@ -107,7 +107,6 @@ public:
 	void readState(StateReader& in);
 
 private:
-	void validateSettings(const IntegratorSettings& settings) const;
 	// One accepted step of the blocks not frozen (frozen_), as step() makes it.
 	double advance(const IntegratorSettings& settings);
 	// Start from rest (IntegratorSettings::startFromRest): static steps

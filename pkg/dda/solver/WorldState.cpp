@@ -12,7 +12,7 @@
 // contacts), the coupled system, and the per-step work arrays.
 #include "StateStream.hpp"
 #include "World.hpp"
-#include "dda/collider/MSCCollider.hpp"
+#include "dda/collider/ColliderFactory.hpp"
 
 #include <algorithm>
 #include <type_traits>
@@ -232,10 +232,7 @@ Contact readContact(StateReader& in, int blocks) {
 }
 
 std::unique_ptr<Collider> colliderNamed(const std::string& name, StateReader& in) {
-	if (name == "DESS") return std::make_unique<DESSCollider>();
-	if (name == "NBS") return std::make_unique<NBSCollider>();
-	if (name == "AllPairs") return std::make_unique<AllPairsCollider>();
-	if (name == "MSC") return std::make_unique<MSCCollider>();
+	if (std::unique_ptr<Collider> collider = makeCollider(name)) return collider;
 	in.fail("unknown collider '" + name + "'");
 }
 
