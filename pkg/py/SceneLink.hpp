@@ -57,7 +57,7 @@ public:
 	long steps() const { return world.steps(); }
 
 	// The whole scene (world and body links) as a framed binary state
-	// (dda/solver/StateStream.hpp), and back. loadState throws StateError
+	// (dda/core/StateStream.hpp), and back. loadState throws StateError
 	// naming the problem and leaves this scene unchanged.
 	std::string saveState() const;
 	void loadState(const std::string& state);

@@ -1,7 +1,7 @@
 // Saving and restoring a SceneLink: the world's state, then each block's link
 // to its YADE body (body id, the body's orientation at creation, vertex order).
 #include "SceneLink.hpp"
-#include "dda/solver/StateStream.hpp"
+#include "dda/core/StateStream.hpp"
 
 namespace dda {
 

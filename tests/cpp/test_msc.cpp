@@ -5,7 +5,7 @@
 #include "dda/collider/Collider.hpp"
 #include "dda/collider/MSCCollider.hpp"
 #include "dda/contact/PairDetection.hpp"
-#include "dda/solver/StateStream.hpp"
+#include "dda/core/StateStream.hpp"
 #include "dda/solver/World.hpp"
 #include "TestScenes.hpp"
 

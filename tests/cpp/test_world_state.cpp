@@ -2,7 +2,7 @@
 // original, and bad input changes nothing.
 #include "TestScenes.hpp"
 #include "dda/collider/MSCCollider.hpp"
-#include "dda/solver/StateStream.hpp"
+#include "dda/core/StateStream.hpp"
 
 #include <gtest/gtest.h>
 

@@ -15,13 +15,13 @@
 // J = integral of d d^T dV alone (see massMatrix).
 #pragma once
 
+#include "dda/core/Types.hpp"
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
 namespace dda {
 
-using Vector3 = Eigen::Vector3d;
-using Matrix3 = Eigen::Matrix3d;
 using Vector6 = Eigen::Matrix<double, 6, 1>;
 using Matrix6 = Eigen::Matrix<double, 6, 6>;
 using Vector12 = Eigen::Matrix<double, 12, 1>;

@@ -7,8 +7,8 @@
 #pragma once
 
 #include "dda/block/Block.hpp"
-#include "dda/contact/SubUnits.hpp"
-#include "dda/util/CapacityBytes.hpp"
+#include "dda/core/CapacityBytes.hpp"
+#include "dda/geometry/SubUnits.hpp"
 
 #include <Eigen/Geometry>
 

@@ -12,7 +12,7 @@
 // compact one in memory (MSCCollider.hpp) is converted to and from: files
 // written before it load unchanged.
 #include "MSCCollider.hpp"
-#include "dda/solver/StateStream.hpp"
+#include "dda/core/StateStream.hpp"
 
 #include <algorithm>
 #include <cstring>

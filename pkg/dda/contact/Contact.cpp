@@ -1,6 +1,6 @@
 #include "Contact.hpp"
 
-#include "dda/util/CapacityBytes.hpp"
+#include "dda/core/CapacityBytes.hpp"
 
 #include <algorithm>
 

@@ -100,8 +100,8 @@
 
 #include "Distance.hpp"
 #include "Linearization.hpp"
-#include "SubUnits.hpp"
 #include "dda/geometry/ConvexPolyhedron.hpp"
+#include "dda/geometry/SubUnits.hpp"
 
 #include <array>
 #include <optional>

@@ -18,18 +18,16 @@
 // its corners.
 #pragma once
 
-#include <Eigen/Core>
+#include "dda/core/Errors.hpp"
+#include "dda/core/Types.hpp"
 
 #include <array>
 #include <memory>
-#include <stdexcept>
 #include <string>
 #include <unordered_map>
 #include <vector>
 
 namespace dda {
-
-using Vector3 = Eigen::Vector3d;
 
 // Distance, as a fraction of the block's bounding-box diagonal, within which a
 // point lies on a face plane (dimensionless). Rule: rotating or translating
@@ -42,14 +40,6 @@ using Vector3 = Eigen::Vector3d;
 // face; a corner closer than this to the plane of a face is rejected (the
 // block is too flat there), never silently dropped.
 inline constexpr double kCoplanarRelativeTolerance = 1e-9;
-
-// Raised for input that cannot be a DDA block. The message names the offending
-// point index and value, e.g. "point 8 (0.5, 0.5, 0.5) lies strictly inside the
-// hull of the others: the input is not convex".
-class InputError : public std::invalid_argument {
-public:
-	using std::invalid_argument::invalid_argument;
-};
 
 // The faces and edges of a convex polyhedron, without the positions of its
 // vertices: all that contact rules and colliders need besides the corners. A

@@ -1,6 +1,6 @@
 #include "CoupledSystem.hpp"
 
-#include "dda/util/CapacityBytes.hpp"
+#include "dda/core/CapacityBytes.hpp"
 
 #include <Eigen/Cholesky>
 #include <Eigen/OrderingMethods>

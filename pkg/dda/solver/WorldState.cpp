@@ -10,9 +10,9 @@
 // the pairs' entrance features. What is not written is rebuilt identically at
 // the start of the next step: the contact store's history index (from the
 // contacts), the coupled system, and the per-step work arrays.
-#include "StateStream.hpp"
 #include "World.hpp"
 #include "dda/collider/ColliderFactory.hpp"
+#include "dda/core/StateStream.hpp"
 
 #include <algorithm>
 #include <type_traits>

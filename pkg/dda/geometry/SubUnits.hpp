@@ -4,7 +4,7 @@
 // phase then loops over those only (Wu et al. 2014, Sec. 4.2).
 #pragma once
 
-#include "dda/geometry/ConvexPolyhedron.hpp"
+#include "ConvexPolyhedron.hpp"
 
 #include <array>
 #include <cstddef>

@@ -9,6 +9,8 @@
 // allocating without limit.
 #pragma once
 
+#include "Errors.hpp"
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -21,13 +23,6 @@
 #include <vector>
 
 namespace dda {
-
-// A saved state that cannot be read: truncated, corrupt, another format
-// version or byte order (Python: ValueError).
-class StateError : public std::invalid_argument {
-public:
-	using std::invalid_argument::invalid_argument;
-};
 
 // Format version of the saved state. Bump it whenever what is written, or the
 // meaning of a written value, changes; older states are then refused by name.

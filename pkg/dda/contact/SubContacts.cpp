@@ -1,0 +1,514 @@
+#include "SubContacts.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <optional>
+
+namespace dda::narrow {
+
+namespace {
+
+// A crossing beside a vertex contact is that contact only if their normals
+// are within about 25 degrees (dimensionless cosine).
+constexpr double kSameNormalCosine = 0.9;
+
+// No sub-contact is deeper than the pair's penetration: a vertex-face or
+// edge-edge gap is at least min(depthBound, 0) - lengthTolerance, depthBound
+// the pair's separating-axis value (detectPairContacts, step 3). Rule, from
+// geometry: for overlapping convex blocks a translation of the penetration
+// depth PD separates them, and it changes any sub-contact's gap, n . (pI -
+// pJ) for a unit n, by at most PD; a gap below -PD would still be negative
+// with the blocks apart, so it measures no contact (a "ghost" the penalty
+// spring pushes on). For blocks apart no gap may be negative. An edge
+// crossing whose line distance is deeper than PD is an edge piercing a face
+// steeply near its boundary, or passing another edge beyond the face's plane.
+// Before, a crossing could be twice the entrance's penetration deep (the
+// narrow-phase oracle, tests/cpp/test_narrow_phase_oracle.cpp, found
+// crossings between 1 and 2 x PD deep in ~1.8% of random near pairs of
+// slender blocks), and once d0 deeper (crossings 9 mm deep between blocks
+// 0.3 to 4 mm apart).
+
+// An edge-edge sub-contact of a face entrance must push within 60 degrees of
+// the face's normal: cosine of that angle (dimensionless). An edge crossing a
+// face's edge steeply (along the face normal) has its line distance in the
+// face's plane; that contact belongs to the neighbouring face, and the
+// vertex-face contacts of its corners already hold the pair along the normal.
+constexpr double kEdgeNormalMinCosine = 0.5;
+
+// Smallest in-plane distance [m] of x's projection from the lines of face f's
+// edges, positive inside the polygon (as vertexFaceDistance's insideMargin).
+double insideMargin(const Prepared& block, int f, const Vector3& x) {
+	const std::vector<int>& face = block.shape->faces[f];
+	const Vector3& n = block.faces[f].normal;
+	double margin = std::numeric_limits<double>::infinity();
+	for (std::size_t k = 0; k < face.size(); ++k) {
+		const Vector3& a = block.corner(face[k]);
+		const Vector3& b = block.corner(face[(k + 1) % face.size()]);
+		const Vector3 inward = n.cross(b - a);
+		const double length = inward.norm();
+		if (!(length > 0)) continue;
+		margin = std::min(margin, inward.dot(x - a) / length);
+	}
+	return margin;
+}
+
+// Does x's projection on the plane of face f lie within `reach` [m] of the
+// polygon? (A corner just past a face's edge or corner makes a contact with
+// it; measured as a distance, not per edge line, so that near an acute corner
+// of the face, too, the corner is within sqrt(2) reach of the face.)
+bool projectionNearFace(const Prepared& block, int f, const Vector3& x, double reach) {
+	const double margin = insideMargin(block, f, x);
+	if (margin >= 0) return true;
+	if (margin < -reach) return false;
+	const std::vector<int>& face = block.shape->faces[f];
+	const Vector3& n = block.faces[f].normal;
+	const Vector3 projected = x - n * n.dot(x - block.corner(face[0]));
+	double nearest = std::numeric_limits<double>::infinity();
+	for (std::size_t k = 0; k < face.size(); ++k)
+		nearest = std::min(nearest, segmentDistance(projected, block.corner(face[k]),
+		                                            block.corner(face[(k + 1) % face.size()])));
+	return nearest <= reach;
+}
+
+// The stencil's start-of-step normal distance, as linearizeNormalDistance's
+// d0 (0 and invalid when S is not positive and finite).
+double stencilGap(const ContactStencil& stencil, bool& valid) {
+	const double area = stencilArea(stencil.kind, stencil.points);
+	const double delta = stencilDeterminant(stencil.points);
+	valid = area > 0 && std::isfinite(area);
+	if (!valid) return 0;
+	return stencil.sigma * delta / area;
+}
+
+SubContact vertexFaceContact(bool firstIsA, const Prepared& blockI, int vertex, const Prepared& blockJ, int face) {
+	SubContact c;
+	c.kind = ContactKind::VertexFace;
+	c.firstIsA = firstIsA;
+	c.feature1 = vertex;
+	c.feature2 = face;
+	const FacePlane& plane = blockJ.faces[face];
+	const Vector3& p = blockI.corner(vertex);
+	c.stencil = vertexFaceStencil(p, blockJ.corner(plane.corners[0]), blockJ.corner(plane.corners[1]),
+	                              blockJ.corner(plane.corners[2]));
+	bool valid = false;
+	c.gap = stencilGap(c.stencil, valid);
+	c.normal = plane.normal;
+	c.pointI = p;
+	c.pointJ = p - c.gap * plane.normal;
+	return c;
+}
+
+// Gap and normal bounds a caller will require of an edge-edge sub-contact;
+// checking them before the closest points saves work, not results.
+struct EdgeContactLimits {
+	double highestGap = std::numeric_limits<double>::infinity();   // [m]
+	double deepestGap = -std::numeric_limits<double>::infinity();  // [m]
+	const Vector3* direction = nullptr;  // normal . direction >= minCosine when set
+	double minCosine = 0;
+};
+
+// Edge-edge sub-contact of edge e1 of block i and e2 of block j, or nothing
+// when the edges are parallel or their closest points are not strictly inside
+// both segments (more than lengthTolerance from every endpoint), or it fails
+// `limits`.
+std::optional<SubContact> edgeEdgeContact(bool firstIsA, const Prepared& blockI, int e1, const Prepared& blockJ,
+                                          int e2, const DetectionSettings& settings, double sinTolerance,
+                                          const EdgeContactLimits& limits = {}) {
+	const Vector3& p1 = blockI.edgeStart(e1);
+	const Vector3& p2 = blockI.edgeEnd(e1);
+	const Vector3& p3 = blockJ.edgeStart(e2);
+	const Vector3& p4 = blockJ.edgeEnd(e2);
+	const Vector3 da = p2 - p1, db = p4 - p3;
+	const Vector3 cross = da.cross(db);
+	// The closest points of the two lines must lie strictly inside both
+	// segments (checked last below, on edgeEdgeDistance's s and t). Most edge
+	// pairs fail that, so it is checked first, on the line parameters
+	// edgeEdgeDistance computes by these same expressions: for edges that are
+	// not parallel its s, t are these when both lie in [0, 1], and otherwise a
+	// value clamped to 0 or 1, which the endpoint test rejects
+	// (lengthTolerance > 0). The same pairs are rejected, only sooner.
+	// Every test below only rejects, so their order changes no result.
+	const Vector3 w = p3 - p1;
+	const double sNumerator = w.cross(db).dot(cross), tNumerator = w.cross(da).dot(cross);
+	{
+		// First without a square root: sLine = sNumerator / nn with nn > 0
+		// (nn = 0 gives no rejection here), so a negative numerator gives a
+		// negative sLine, or -0 for an underflow, which the endpoint test
+		// rejects; and nn is cross.squaredNorm() to within a few DBL_EPSILON
+		// (|cross| rounded, then squared), so a numerator above
+		// (1 + 1e-12) squaredNorm gives sLine > 1.
+		const double bound = (1 + 1e-12) * cross.squaredNorm();
+		if (sNumerator < 0 || tNumerator < 0 || sNumerator > bound || tNumerator > bound) return std::nullopt;
+	}
+	const double la = da.norm(), lb = db.norm();
+	const double crossNorm = cross.norm();
+	if (parallelDirections(da, db, cross, crossNorm, la, lb, sinTolerance)) return std::nullopt;
+	const double tol = settings.lengthTolerance;
+	{
+		const double nn = crossNorm * crossNorm;
+		const double sLine = sNumerator / nn;
+		const double tLine = tNumerator / nn;
+		if (!(sLine >= 0 && sLine <= 1 && tLine >= 0 && tLine <= 1)) return std::nullopt;
+		if (sLine * la <= tol || (1 - sLine) * la <= tol || tLine * lb <= tol || (1 - tLine) * lb <= tol)
+			return std::nullopt;
+	}
+	{
+		// The gap limits, on the distance of the two lines before the stencil:
+		// the stencil's |gap| is |Delta| / S with S = crossNorm (the same
+		// expression) and Delta = da . (w x (p4 - p1)), whose exact value is
+		// -w . cross. Each of the two triple products is within 10
+		// DBL_EPSILON x (the product of its factors' lengths) of its exact
+		// value; `margin` bounds both errors, with 1-norms for lengths and
+		// 1e-12 for 10 DBL_EPSILON (a factor of ~450 to spare), so a line
+		// distance above a limit's magnitude by more than it means a gap
+		// outside that limit.
+		const auto norm1 = [](const Vector3& v) { return std::abs(v.x()) + std::abs(v.y()) + std::abs(v.z()); };
+		const double w1 = norm1(w);
+		const double margin = 1e-12 * norm1(da) * w1 * (w1 + 2 * norm1(db)) / crossNorm;
+		const double lineGap = std::abs(w.dot(cross)) / crossNorm;
+		if (lineGap - margin > std::max(limits.highestGap, -limits.deepestGap)) return std::nullopt;
+	}
+	// From block i towards block j: out of i at its edge, into j at its edge.
+	const Vector3 reference = blockI.edgeOutward(e1) - blockJ.edgeOutward(e2);
+	SubContact c;
+	c.stencil = edgeEdgeStencil(p1, p2, p3, p4, reference);
+	bool valid = false;
+	c.gap = stencilGap(c.stencil, valid);
+	if (!valid) return std::nullopt;
+	if (c.gap > limits.highestGap || c.gap < limits.deepestGap) return std::nullopt;
+	// The stencil's n = -sigma (a x b)/|a x b| points from i to j.
+	c.normal = c.stencil.sigma * (cross / crossNorm);  // da.cross(db).normalized(), as in edgeAxis
+	if (limits.direction && c.normal.dot(*limits.direction) < limits.minCosine) return std::nullopt;
+	const EdgeEdgeResult r =
+	    edgeEdgeDistance(p1, p2, p3, p4, reference, settings.lengthTolerance, settings.angleTolerance);
+	if (r.parallel || !r.interior) return std::nullopt;
+	if (r.s * la <= tol || (1 - r.s) * la <= tol || r.t * lb <= tol || (1 - r.t) * lb <= tol) return std::nullopt;
+	c.kind = ContactKind::EdgeEdge;
+	c.firstIsA = firstIsA;
+	c.feature1 = e1;
+	c.feature2 = e2;
+	c.pointI = r.closestI;
+	c.pointJ = r.closestJ;
+	return c;
+}
+
+// An edge-edge contact within `merge` [m] of the point of a vertex-face contact
+// that pushes the same way (normals within acos(kSameNormalCosine)); a
+// crossing whose normal differs is a different contact, even beside a corner
+// (two turned logs side by side: a corner just below the other log's bottom
+// face, an edge crossing into its side face).
+bool besideVertexContact(const SubContact& crossing, const std::vector<SubContact>& found, double merge) {
+	for (const SubContact& other : found) {
+		if (other.kind != ContactKind::VertexFace) continue;
+		if (std::abs(other.normal.dot(crossing.normal)) < kSameNormalCosine) continue;
+		if ((other.pointI - crossing.pointI).norm() <= merge || (other.pointI - crossing.pointJ).norm() <= merge)
+			return true;
+	}
+	return false;
+}
+
+// The vertex-face contact of corner q of `block` against its own entrance
+// face G of `other`, the face whose plane q lies farthest above, when that
+// distance is within `reach` [m] and q's projection within `reach` of G;
+// appended to `out`. The gap is then at least minus the pair's penetration:
+// for q outside `other` it is positive (some face plane separates a point
+// from a convex block), for q inside it is minus q's distance to the
+// boundary, which a translation of the penetration depth carries q across.
+void ownEntranceContact(const Prepared& block, bool blockIsA, int q, const Prepared& other, double reach,
+                        std::vector<SubContact>& out) {
+	const Vector3& x = block.corner(q);
+	int bestFace = -1;
+	double bestDistance = -std::numeric_limits<double>::infinity();
+	for (int g = 0; g < other.faceCount(); ++g) {
+		if (other.internal(g)) continue;
+		++*block.tests;
+		ensurePlane(other, g);
+		const double d = planeDistance(other, g, x);
+		if (d > bestDistance) {
+			bestDistance = d;
+			bestFace = g;
+		}
+	}
+	if (bestFace < 0 || bestDistance > reach) return;
+	if (!projectionNearFace(other, bestFace, x, reach)) return;
+	out.push_back(vertexFaceContact(blockIsA, block, q, other, bestFace));
+}
+
+// Step 3 for a face entrance: face f of block `owner` (block j of every
+// vertex-face contact of the other block's corners) entered by block `other`.
+// `depthBound` is the pair's separation (<= 0 when they overlap) as step 3
+// of detectPairContacts takes it: no sub-contact is deeper than the pair's
+// penetration allows (min(depthBound, 0), to the length tolerance; for edge
+// crossings min(crossingBound, 0), crossingBound >= depthBound). It is
+// f's own separation, the lowest corner's distance from f's plane, only when
+// f bounds the pair's penetration (f is the best axis, or kept by
+// hysteresis); for the face search of an edge entrance, and for the face an
+// edge entrance falls back to, f's plane may lie far inside the other block:
+// two crossed logs a few mm apart have face axes a log's width deep, and
+// corners and edge crossings that deep below f are no contact of theirs (they
+// gave sub-contacts 1 m deep between logs that did not touch).
+void faceEntranceContacts(const Prepared& owner, bool ownerIsA, int f, const Prepared& other, double depthBound,
+                          double crossingBound, const DetectionSettings& settings, double sinTolerance, Scratch& s,
+                          std::vector<SubContact>& out) {
+	// Within d0, to the length tolerance: a face is planar only to within it, so
+	// a corner touching a face may lie that far off the face's triangle plane.
+	const double reach = settings.contactDistance + settings.lengthTolerance;
+
+	// The other block's corners' distances from the face's plane, each
+	// computed when first needed.
+	std::vector<double>& distances = s.cornerDistances;
+	std::vector<char>& ready = s.cornerDistanceReady;
+	distances.resize(other.cornerCount());
+	ready.assign(other.cornerCount(), 0);
+	const auto distance = [&](int v) {
+		if (!ready[v]) {
+			distances[v] = planeDistance(owner, f, other.corner(v));
+			ready[v] = 1;
+			++*owner.tests;
+		}
+		return distances[v];
+	};
+
+	// Corners of the other block on the face, none deeper below its plane than
+	// the pair's penetration (to the length tolerance): when f bounds the
+	// penetration every corner is at least `depthBound` above the plane, so
+	// this bound only acts when it does not (an edge entrance's face search, or
+	// its fallback face), where a corner below f's plane of a pair that does
+	// not overlap lies past another face of f's block (its gap would have the
+	// wrong sign).
+	const double lowest = std::min(depthBound, 0.0) - settings.lengthTolerance;
+	std::vector<int>& used = s.used;
+	used.clear();
+	for (int v : other.vertexList) {
+		if (distance(v) > reach || distance(v) < lowest) continue;
+		if (!projectionNearFace(owner, f, other.corner(v), reach)) continue;
+		out.push_back(vertexFaceContact(!ownerIsA, other, v, owner, f));
+		used.push_back(v);
+	}
+
+	// Corners of the face near the other block, against their own entrance face.
+	const double merge = std::max(settings.cornerMergeDistance, settings.lengthTolerance);
+	for (int q : owner.shape->faces[f]) {
+		if (!owner.linkedVertex(q)) continue;
+		const Vector3& x = owner.corner(q);
+		bool coincident = false;  // with a corner used above
+		for (int v : used) {
+			if ((other.corner(v) - x).norm() <= merge) {
+				coincident = true;
+				break;
+			}
+		}
+		if (coincident) continue;
+		ownEntranceContact(owner, ownerIsA, q, other, reach, out);
+	}
+
+	// Edges of the other block crossing the face's edges, no deeper than the
+	// pair's penetration allows (the rule at the top of this file; for
+	// crossings `crossingBound`, which near-parallel edge axes may raise).
+	const double deepest = std::min(crossingBound, 0.0) - settings.lengthTolerance;
+	std::vector<int>& faceEdges = s.faceEdges;
+	faceEdges.clear();
+	for (int e : owner.edgeList) {
+		const auto& ef = owner.shape->edgeFaces[e];
+		if (ef[0] == f || ef[1] == f) faceEdges.push_back(e);
+	}
+	// A crossing beside a vertex contact found above is that corner's contact
+	// (two squares offset by a little drift cross each other's edges right
+	// beside their corners); a crossing with no vertex contact near it stays.
+	// (`merge` is the corner merge distance above.)
+	EdgeContactLimits limits;
+	limits.highestGap = reach;
+	limits.deepestGap = deepest;
+	limits.direction = &owner.faces[f].normal;
+	limits.minCosine = kEdgeNormalMinCosine;
+	const auto& otherEdges = other.shape->edges;
+	for (int e : other.edgeList) {
+		const double low = std::min(distance(otherEdges[e][0]), distance(otherEdges[e][1]));
+		if (low > reach) continue;
+		for (int g : faceEdges) {
+			++*owner.tests;
+			std::optional<SubContact> c =
+			    edgeEdgeContact(!ownerIsA, other, e, owner, g, settings, sinTolerance, limits);
+			if (!c) continue;
+			if (planeDistance(owner, f, c->pointI) > reach) continue;  // crosses far from the face
+			if (besideVertexContact(*c, out, merge)) continue;
+			out.push_back(*c);
+		}
+	}
+}
+
+// faceEntranceContacts for entrance face `face` of A or of B, entered by the
+// other block.
+void entranceFaceContacts(const Prepared& a, const Prepared& b, const EntranceFeature& face, double depthBound,
+                          double crossingBound, const DetectionSettings& settings, double sinTolerance, Scratch& s,
+                          std::vector<SubContact>& out) {
+	if (face.kind == EntranceFeature::FaceOfA)
+		faceEntranceContacts(a, true, face.feature, b, depthBound, crossingBound, settings, sinTolerance, s, out);
+	else
+		faceEntranceContacts(b, false, face.feature, a, depthBound, crossingBound, settings, sinTolerance, s, out);
+}
+
+// Step 3 for an edge entrance, after its crossing (out[0]): the features the
+// best face axis finds within d0 elsewhere. Two blocks touching edge on edge
+// near one corner can have a far corner within d0 too (a cube tilting onto
+// another: it rocks on the crossing and its far corner comes down); with the
+// crossing alone that corner would enter the other block unopposed in the
+// step. What the face finds at the crossing itself (the same edge pair, or a
+// corner or crossing within the corner merge distance of it) is the crossing's
+// contact and is left out. `depthBound` is the edge axis's separation (the
+// pair's), `crossingBound` as for faceEntranceContacts.
+void otherFeaturesOfEdgeEntrance(const Prepared& a, const Prepared& b, const EntranceFeature& face, double depthBound,
+                                 double crossingBound, const DetectionSettings& settings, double sinTolerance,
+                                 Scratch& s, std::vector<SubContact>& out) {
+	const SubContact crossing = out.front();
+	const std::size_t first = out.size();
+	entranceFaceContacts(a, b, face, depthBound, crossingBound, settings, sinTolerance, s, out);
+	const double merge = std::max(settings.cornerMergeDistance, settings.lengthTolerance);
+	const auto sameAsCrossing = [&](const SubContact& c) {
+		if (c.kind == ContactKind::EdgeEdge) {
+			const int edgeA = c.firstIsA ? c.feature1 : c.feature2, edgeB = c.firstIsA ? c.feature2 : c.feature1;
+			if (edgeA == crossing.feature1 && edgeB == crossing.feature2) return true;
+		}
+		for (const Vector3* p : {&c.pointI, &c.pointJ})
+			if ((*p - crossing.pointI).norm() <= merge || (*p - crossing.pointJ).norm() <= merge) return true;
+		return false;
+	};
+	out.erase(std::remove_if(out.begin() + static_cast<std::ptrdiff_t>(first), out.end(), sameAsCrossing), out.end());
+}
+
+// Step 3 for an edge entrance whose two edges do not cross strictly inside,
+// after the best face's contacts (the fallback): the ends of the two edges,
+// each against its own entrance face of the other block (ownEntranceContact).
+// The edge axis is the pair's best, so the blocks' closest features are then
+// a corner at an end of one edge and the other edge (or its end); the best
+// face, which the edge axis beat, may lie far from them (crossed slender
+// blocks: a block's width deep), so its search alone can find nothing. Pairs
+// within d0 were left without any sub-contact (9 of the oracle's 100,000
+// random near pairs; the second pair of ghost_pairs.json, 6.5 mm apart), and a
+// corner coming down on an edge would have met no contact. An end that already
+// has a vertex-face contact, or lies within the corner merge distance of a
+// contact point found, is that contact.
+void cornersOfEdgeEntrance(const Prepared& a, int edgeA, const Prepared& b, int edgeB,
+                           const DetectionSettings& settings, std::vector<SubContact>& out) {
+	const double reach = settings.contactDistance + settings.lengthTolerance;
+	const double merge = std::max(settings.cornerMergeDistance, settings.lengthTolerance);
+	for (int side = 0; side < 2; ++side) {
+		const Prepared& block = side == 0 ? a : b;
+		const Prepared& other = side == 0 ? b : a;
+		const bool blockIsA = side == 0;
+		for (int q : block.shape->edges[side == 0 ? edgeA : edgeB]) {
+			if (!block.linkedVertex(q)) continue;
+			const Vector3& x = block.corner(q);
+			const bool known = std::any_of(out.begin(), out.end(), [&](const SubContact& c) {
+				if (c.kind == ContactKind::VertexFace && c.firstIsA == blockIsA && c.feature1 == q) return true;
+				return (c.pointI - x).norm() <= merge || (c.pointJ - x).norm() <= merge;
+			});
+			if (!known) ownEntranceContact(block, blockIsA, q, other, reach, out);
+		}
+	}
+}
+
+// The pair's normal (from A towards B) when `face` is its entrance: the
+// face's outward normal, negated for a face of B.
+Vector3 faceEntranceNormal(const Prepared& a, const Prepared& b, const EntranceFeature& face) {
+	return face.kind == EntranceFeature::FaceOfA ? a.faces[face.feature].normal : Vector3(-b.faces[face.feature].normal);
+}
+
+// A face entrance that found nothing, among faces tied with the best
+// (within lengthTolerance): the next tied face that finds something is the
+// entrance. Two halves of a nearly planar side tie, and the one of larger
+// area may not be the one the other block's corners lie over: a pair 9.2
+// mm apart and one overlapping by 0.38 mm had no sub-contact at all (2 of
+// 2 million random near pairs of the oracle).
+void tiedFaceContacts(const Prepared& a, const Prepared& b, const std::vector<FaceCandidate>& faces,
+                      const AxisSearch& axes, double depthBound, double crossingBound,
+                      const DetectionSettings& settings, double sinTolerance, Scratch& s, Entrance& entrance,
+                      PairContacts& out) {
+	for (const FaceCandidate& c : faces) {
+		if (c.separation < axes.bestFace - settings.lengthTolerance || c.feature == entrance.feature) continue;
+		entranceFaceContacts(a, b, c.feature, depthBound, crossingBound, settings, sinTolerance, s, out.contacts);
+		if (out.contacts.empty()) continue;
+		entrance = {c.feature, c.separation};
+		out.normal = faceEntranceNormal(a, b, c.feature);
+		break;
+	}
+}
+
+}  // namespace
+
+// No sub-contact may be deeper than the pair's penetration (the rule at
+// the top of this file); `depthBound` is the entrance axis's separation,
+// the pair's best axis (or the previous entrance, kept while within
+// `hysteresis` of it). It stays the edge axis's when an edge entrance falls
+// back to the best face below. That face's own separation bounds nothing:
+// the edge axis beat it by more than lengthTolerance, and for crossed
+// slender blocks a face axis lies a block's width deep while the blocks are
+// mm apart. Taking the face's separation as the bound, as before, let
+// corners and crossings that deep count as contacts: the ghosts of the
+// 50,000-block deposit (an edge crossing 0.25 m deep and a corner 2.6 mm
+// deep between blocks 5.65 and 6.5 mm apart, ghost_pairs.json;
+// `GhostPairsOfTheDepositHaveNoNegativeGap`), 13 of the oracle's 100,000
+// random near pairs, and 257 of 16,613 calls with a previous entrance.
+// An edge pair parallel within the angle tolerance is no entrance, but
+// its axis bounds the penetration as well: when it separates the blocks
+// more than the entrance, it bounds the edge crossings (a box lying along
+// a slender block, edge along edge 0.01 rad apart: the entrance crossing of
+// two other edges was 6.12 mm deep where the blocks overlapped by 5.84 mm;
+// 1 of 2 million random near pairs of the oracle). Not the corners: the
+// contact of two such edges is the vertex contacts at their ends, measured
+// along the entrance face's normal, which lie deeper than the overlap
+// across the edges (a bar resting edge on edge 1e-4 rad from parallel
+// sank 0.13 mm into the other, tests/py/test_hard_cases.py, when its
+// corners were bound by it).
+void findSubContacts(const Prepared& a, const Prepared& b, const std::vector<FaceCandidate>& faces,
+                     const AxisSearch& axes, const EntranceFeature& previous, const DetectionSettings& settings,
+                     double sinTolerance, Scratch& s, Entrance& entrance, PairContacts& out) {
+	const double tol = settings.lengthTolerance;
+	// The bound is the largest separation over every axis tested
+	// (deepestBound: faces, internal ones too, and the edge pairs that are not
+	// near-parallel), never the entrance's own when that lies deeper: a
+	// previous entrance kept by hysteresis may lie up to `hysteresis` deeper
+	// than the best axis, and bounding by it let corners that deep below its
+	// plane count as contacts. In a pile of 200 cubes at E = 1e11 Pa a cube
+	// landing on another was given a corner contact 0.43 mm deep while the
+	// cubes overlapped by 1.8 um: 363 kJ in its penalty spring, 37 times the
+	// cube's kinetic energy (core 90eae68, the account's contactChanges).
+	const double depthBound = std::max(entrance.separation, axes.deepestBound);
+	const double crossingBound = std::max(depthBound, axes.nearParallelBest);
+	std::optional<std::array<int, 2>> fallbackEdges;  // the edge entrance's edges, when it falls back
+	out.normal = Vector3::UnitZ();  // the default, kept when no entrance sets it
+	out.contacts.clear();
+	if (entrance.feature.kind == EntranceFeature::EdgePair) {
+		EdgeContactLimits limits;  // the crossing, too, no deeper than the bound
+		limits.deepestGap = std::min(crossingBound, 0.0) - tol;
+		std::optional<SubContact> c = edgeEdgeContact(true, a, entrance.feature.feature, b, entrance.feature.other,
+		                                              settings, sinTolerance, limits);
+		if (c) {
+			out.normal = (axes.previousEdge.valid && entrance.feature == previous) ? axes.previousEdge.normal
+			                                                                        : axes.bestEdge.normal;
+			out.contacts.push_back(*c);
+			otherFeaturesOfEdgeEntrance(a, b, chooseFace(faces, a, b, tol, previous).feature, depthBound,
+			                            crossingBound, settings, sinTolerance, s, out.contacts);
+		} else {
+			// The edges do not cross strictly inside (a corner meets an edge),
+			// or their crossing is deeper than the bound: the best face is the
+			// entrance, its separation the pair's reported one, but the depth
+			// bound stays the edge axis's.
+			fallbackEdges = {entrance.feature.feature, entrance.feature.other};
+			const FaceCandidate& f = chooseFace(faces, a, b, tol, previous);
+			entrance = {f.feature, f.separation};
+		}
+	}
+	if (entrance.feature.kind == EntranceFeature::FaceOfA || entrance.feature.kind == EntranceFeature::FaceOfB) {
+		out.normal = faceEntranceNormal(a, b, entrance.feature);
+		entranceFaceContacts(a, b, entrance.feature, depthBound, crossingBound, settings, sinTolerance, s,
+		                     out.contacts);
+	}
+	if (fallbackEdges) cornersOfEdgeEntrance(a, (*fallbackEdges)[0], b, (*fallbackEdges)[1], settings, out.contacts);
+	if (out.contacts.empty() && entrance.feature.kind != EntranceFeature::EdgePair)
+		tiedFaceContacts(a, b, faces, axes, depthBound, crossingBound, settings, sinTolerance, s, entrance, out);
+}
+
+}  // namespace dda::narrow
