@@ -1,3 +1,7 @@
+// The World facade (World.hpp): its blocks, their loads and velocities, the
+// settings' checks, and the order of a step (World::step, advance). The parts
+// a step runs have their own files (doc/DESIGN.md, "Source layout"):
+// ContactDetection, OpenClose, TimeStepControl, EnergyAccount, Settling.
 #include "World.hpp"
 
 #include "ContactEquations.hpp"
