@@ -274,6 +274,58 @@ Vector3 tangentialForce(const Contact& contact, const Block& blockI, const Block
 	return -(contact.slipLimit * contact.stretch / stretch + slipStiffness(contact) * (s - contact.stretch));
 }
 
+namespace {
+// The bound E on the rounding of searchLine's computed phi' over t in [0, 1].
+double roundoffBound(const ContactLine* begin, const ContactLine* end, double slope, double curvature) {
+	// E: |computed - exact| over t in [0, 1]. Each term's rounding is a
+	// few units of roundoff u of a bound m_c on the sizes it is computed
+	// from (the normal spring's w_s kn (|d| + |d'|) |d'|, zero and exact
+	// when the gap stays positive; the tangential one w_t (ks (|s|_1 +
+	// |s'|_1) |s'|_1 + L |s'|_1), which also covers the two sides of the
+	// stick-slip branch); the sum's is (n - 1) u times the sum of the
+	// terms' sizes. Taken 4 x over (n + 20) u; a negative curvature
+	// (round-off of a quadratic form) makes phi' fall by at most
+	// |curvature| on [0, 1]. w_s, w_c, w_t are the line's springWeight,
+	// secantWeight, tangentialWeight (1, 0, 1 under Shi's scheme, where
+	// E is the same number as without them).
+	//
+	// The secant term (gamma < 1) w_c h(d) d', with d = d(0) + t d' the
+	// gap and h = normalSecant(d0, d).value, has m_c = w_c kn (|d(0)| +
+	// |d'| + |d0|) |d'|. Exact h rises with d (ContactEquations.hpp), so
+	// the exact phi' still rises with t, and:
+	// - the computed gap misses d by at most 2u (|d(0)| + |d'|) (t d'
+	//   and the sum, t in [0, 1]);
+	// - h is continuous with 0 <= h' <= kn/2 in every branch (closed:
+	//   kn/2; released: kn d0^2 / 2q^2 with |q| = |d - d0| >= |d0|;
+	//   closing: kn (d^2 - 2 d d0) / 2q^2 <= kn/2 as q^2 = that +
+	//   d0^2), so that miss moves h by at most u kn (|d(0)| + |d'|);
+	// - each branch evaluated at the computed gap rounds by at most
+	//   about 4u (q's rounding and three operations) of its size,
+	//   which is at most kn/2 (|d| + |d0|): kn |d + d0|/2 closed,
+	//   kn d0^2 / 2|q| <= kn |d0|/2 released, kn d^2 / 2|q| <= kn |d|/2
+	//   closing;
+	// - the two products with w_c and d' add 2u of |w_c h d'|.
+	// Together about 5u m_c, within the 4 (n + 20) u taken. Apart at
+	// both ends (d0 > 0 and the gap positive over the line) the secant
+	// is exactly 0, computed and exact.
+	double size = std::abs(slope) + std::abs(curvature);
+	for (const ContactLine* line = begin; line != end; ++line) {
+		const double gap = line->gap, rate = std::abs(line->gapRate);
+		const bool apart = !line->bonded && gap > 0 && gap + line->gapRate > 4 * kRoundoff * (gap + rate);
+		if (!apart) size += line->springWeight * line->normalStiffness * (std::abs(gap) + rate) * rate;
+		if (line->secantWeight > 0 && !(apart && line->startGap > 0))
+			size += line->secantWeight * line->normalStiffness *
+			        (std::abs(gap) + rate + std::abs(line->startGap)) * rate;
+		if (line->tangential) {
+			const double s = line->stretch.cwiseAbs().sum(), r = line->stretchRate.cwiseAbs().sum();
+			size += line->tangentialWeight * (line->shearStiffness * (s + r) * r + line->limit * r);
+		}
+	}
+	const double n = static_cast<double>(end - begin);
+	return 4 * (n + 20) * kRoundoff * size + (curvature < 0 ? -curvature : 0);
+}
+}  // namespace
+
 double searchLine(const ContactLine* begin, const ContactLine* end, double slope, double curvature, bool certified,
                   long* evaluations) {
 	long count = 0;
@@ -297,53 +349,7 @@ double searchLine(const ContactLine* begin, const ContactLine* end, double slope
 		if (value > 2 * bound) positiveFrom = std::min(positiveFrom, at);
 	};
 	if (certified) {
-		// E: |computed - exact| over t in [0, 1]. Each term's rounding is a
-		// few units of roundoff u of a bound m_c on the sizes it is computed
-		// from (the normal spring's w_s kn (|d| + |d'|) |d'|, zero and exact
-		// when the gap stays positive; the tangential one w_t (ks (|s|_1 +
-		// |s'|_1) |s'|_1 + L |s'|_1), which also covers the two sides of the
-		// stick-slip branch); the sum's is (n - 1) u times the sum of the
-		// terms' sizes. Taken 4 x over (n + 20) u; a negative curvature
-		// (round-off of a quadratic form) makes phi' fall by at most
-		// |curvature| on [0, 1]. w_s, w_c, w_t are the line's springWeight,
-		// secantWeight, tangentialWeight (1, 0, 1 under Shi's scheme, where
-		// E is the same number as without them).
-		//
-		// The secant term (gamma < 1) w_c h(d) d', with d = d(0) + t d' the
-		// gap and h = normalSecant(d0, d).value, has m_c = w_c kn (|d(0)| +
-		// |d'| + |d0|) |d'|. Exact h rises with d (ContactEquations.hpp), so
-		// the exact phi' still rises with t, and:
-		// - the computed gap misses d by at most 2u (|d(0)| + |d'|) (t d'
-		//   and the sum, t in [0, 1]);
-		// - h is continuous with 0 <= h' <= kn/2 in every branch (closed:
-		//   kn/2; released: kn d0^2 / 2q^2 with |q| = |d - d0| >= |d0|;
-		//   closing: kn (d^2 - 2 d d0) / 2q^2 <= kn/2 as q^2 = that +
-		//   d0^2), so that miss moves h by at most u kn (|d(0)| + |d'|);
-		// - each branch evaluated at the computed gap rounds by at most
-		//   about 4u (q's rounding and three operations) of its size,
-		//   which is at most kn/2 (|d| + |d0|): kn |d + d0|/2 closed,
-		//   kn d0^2 / 2|q| <= kn |d0|/2 released, kn d^2 / 2|q| <= kn |d|/2
-		//   closing;
-		// - the two products with w_c and d' add 2u of |w_c h d'|.
-		// Together about 5u m_c, within the 4 (n + 20) u taken. Apart at
-		// both ends (d0 > 0 and the gap positive over the line) the secant
-		// is exactly 0, computed and exact.
-		double size = std::abs(slope) + std::abs(curvature);
-		for (const ContactLine* line = begin; line != end; ++line) {
-			const double gap = line->gap, rate = std::abs(line->gapRate);
-			const bool apart =
-			    !line->bonded && gap > 0 && gap + line->gapRate > 4 * kRoundoff * (gap + rate);
-			if (!apart) size += line->springWeight * line->normalStiffness * (std::abs(gap) + rate) * rate;
-			if (line->secantWeight > 0 && !(apart && line->startGap > 0))
-				size += line->secantWeight * line->normalStiffness *
-				        (std::abs(gap) + rate + std::abs(line->startGap)) * rate;
-			if (line->tangential) {
-				const double s = line->stretch.cwiseAbs().sum(), r = line->stretchRate.cwiseAbs().sum();
-				size += line->tangentialWeight * (line->shearStiffness * (s + r) * r + line->limit * r);
-			}
-		}
-		const double n = static_cast<double>(end - begin);
-		bound = 4 * (n + 20) * kRoundoff * size + (curvature < 0 ? -curvature : 0);
+		bound = roundoffBound(begin, end, slope, curvature);
 		if (!std::isfinite(bound)) certified = false;
 	}
 	if (certified) {

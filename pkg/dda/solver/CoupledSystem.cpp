@@ -58,6 +58,23 @@ struct CoupledSystem::Analysis {
 void CoupledSystem::AnalysisDeleter::operator()(Analysis* a) const { delete a; }
 
 namespace {
+// Analyses the pattern of the lower-triangle `entries` (values: their
+// assembly indices) of an n x n matrix, and sets position[e] to entry e's
+// index in the permuted matrix's values.
+void analysePattern(const std::vector<Eigen::Triplet<double>>& entries, int n, KeptCholesky& llt,
+                    std::vector<int>& position) {
+	Eigen::SparseMatrix<double> indexed(n, n);
+	indexed.setFromTriplets(entries.begin(), entries.end());
+	llt.analyse(indexed);
+	const Eigen::SparseMatrix<double>& permuted = llt.permuted();
+	position.assign(entries.size(), -1);
+	const double* index = permuted.valuePtr();
+	for (Eigen::Index p = 0; p < permuted.nonZeros(); ++p)
+		position[static_cast<std::size_t>(index[p])] = static_cast<int>(p);
+}
+}  // namespace
+
+namespace {
 
 // Patterns unused for this many builds are dropped.
 constexpr long kKeptBuilds = 16;
@@ -135,7 +152,10 @@ void CoupledSystem::build(int movingBlocks, const std::vector<std::pair<int, int
 	offDiagonal_.resize(linkSlots_.size());
 	diagonal_.resize(coupledBlocks);
 	force_.resize(coupledBlocks);
+	keepAnalyses();
+}
 
+void CoupledSystem::keepAnalyses() {
 	// Each sparse component's kept analysis, by its pattern (a pattern kept
 	// once serves one component per build: components solve in parallel).
 	++builds_;
@@ -229,6 +249,19 @@ std::size_t CoupledSystem::memoryBytes() const {
 	       capacityBytes(offDiagonal_) + kept;
 }
 
+bool CoupledSystem::solveSingleBlock(int slot, std::vector<Vector12>& solutions) const {
+	const int k = members_[slot];
+	if (unknowns_[slot] == kRigidBlockDofs) {
+		Eigen::LLT<Matrix6> llt(diagonal_[slot].topLeftCorner<kRigidBlockDofs, kRigidBlockDofs>());
+		solutions[k].head<kRigidBlockDofs>() = llt.solve(force_[slot].head<kRigidBlockDofs>());
+		solutions[k].tail<kBlockDofs - kRigidBlockDofs>().setZero();
+		return llt.info() == Eigen::Success;
+	}
+	Eigen::LLT<Matrix12> llt(diagonal_[slot]);
+	solutions[k] = llt.solve(force_[slot]);
+	return llt.info() == Eigen::Success;
+}
+
 void CoupledSystem::solve(std::vector<Vector12>& solutions, int threadsFrom) {
 	const int count = components();
 	bool failed = false;
@@ -239,23 +272,10 @@ void CoupledSystem::solve(std::vector<Vector12>& solutions, int threadsFrom) {
 	for (int c = 0; c < count; ++c) {
 		const int first = componentStart_[c], last = componentStart_[c + 1];
 		if (last - first == 1) {
-			const int k = members_[first];
 			solved += unknowns_[first];
-			if (unknowns_[first] == kRigidBlockDofs) {
-				Eigen::LLT<Matrix6> llt(diagonal_[first].topLeftCorner<kRigidBlockDofs, kRigidBlockDofs>());
-				if (llt.info() != Eigen::Success) {
+			if (!solveSingleBlock(first, solutions)) {
 #pragma omp atomic write
-					failed = true;
-				}
-				solutions[k].head<kRigidBlockDofs>() = llt.solve(force_[first].head<kRigidBlockDofs>());
-				solutions[k].tail<kBlockDofs - kRigidBlockDofs>().setZero();
-			} else {
-				Eigen::LLT<Matrix12> llt(diagonal_[first]);
-				if (llt.info() != Eigen::Success) {
-#pragma omp atomic write
-					failed = true;
-				}
-				solutions[k] = llt.solve(force_[first]);
+				failed = true;
 			}
 			continue;
 		}
@@ -312,14 +332,8 @@ void CoupledSystem::solve(std::vector<Vector12>& solutions, int threadsFrom) {
 				forEachEntry([&](int row, int col, double) {
 					entries.emplace_back(row, col, static_cast<double>(entries.size()));
 				});
-				Eigen::SparseMatrix<double> indexed(n, n);
-				indexed.setFromTriplets(entries.begin(), entries.end());
-				analysis->llt.analyse(indexed);
+				analysePattern(entries, n, analysis->llt, analysis->position);
 				const Eigen::SparseMatrix<double>& permuted = analysis->llt.permuted();
-				analysis->position.assign(entries.size(), -1);
-				const double* index = permuted.valuePtr();
-				for (Eigen::Index p = 0; p < permuted.nonZeros(); ++p)
-					analysis->position[static_cast<std::size_t>(index[p])] = static_cast<int>(p);
 				analysis->unknowns = n;
 				analysis->bytes = static_cast<std::size_t>(permuted.nonZeros()) * (sizeof(double) + sizeof(int)) +
 				                  capacityBytes(analysis->position) +

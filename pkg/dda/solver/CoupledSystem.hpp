@@ -101,9 +101,12 @@ private:
 		void operator()(Analysis* a) const;
 	};
 	using AnalysisPtr = std::unique_ptr<Analysis, AnalysisDeleter>;
-	// Finds (or adds) the kept analysis of component c's pattern.
-	Analysis* analysisFor(int c);
-	Analysis* analyse(int c, Analysis* kept);
+	// build's last part: each sparse component's kept analysis (found by its
+	// pattern, or added), and the unused ones dropped.
+	void keepAnalyses();
+	// Solves the component of the single block in `slot` (a dense Cholesky of
+	// its 12 or 6 unknowns); false when the factorisation fails.
+	bool solveSingleBlock(int slot, std::vector<Vector12>& solutions) const;
 
 	std::vector<int> slot_;            // per moving block: its slot, -1 when it has no springs
 	std::vector<int> members_;         // per slot: the moving block

@@ -242,14 +242,10 @@ void World::writeState(StateWriter& out) const {
 	out.tag("WRLD");
 	out.pod(time_);
 	out.pod(steps_);
-	out.pod(nextTimeStep_);
-	out.pod(openCloseFailures_);
-	out.pod(displacementLimitMisses_);
+	timeStep_.writeState(out);  // next dt, open-close failures, displacement-limit misses
 	out.pod(sceneHalfSize_);
 	out.pod(sceneSizedBlocks_);
-	out.pod(internalFacesBlocks_);
-	out.size(internalFaces_.size());
-	for (const auto& faces : internalFaces_) out.podVector(faces);
+	detection_.writeState(out);  // the flush-joint faces
 	out.size(sizeof(StepStatistics));
 	out.pod(stats_);
 	out.tag("ENRG");
@@ -288,14 +284,10 @@ void World::readState(StateReader& in) {
 	in.tag("WRLD");
 	in.pod(w.time_);
 	in.pod(w.steps_);
-	in.pod(w.nextTimeStep_);
-	in.pod(w.openCloseFailures_);
-	in.pod(w.displacementLimitMisses_);
+	w.timeStep_.readState(in);
 	in.pod(w.sceneHalfSize_);
 	in.pod(w.sceneSizedBlocks_);
-	in.pod(w.internalFacesBlocks_);
-	w.internalFaces_.resize(in.size(8, "internal-face lists"));
-	for (auto& faces : w.internalFaces_) in.podVector(faces, "internal faces");
+	w.detection_.readState(in);
 	const std::size_t statsBytes = in.size(1, "statistics bytes");
 	if (statsBytes == sizeof(StepStatistics)) {
 		in.pod(w.stats_);
@@ -315,9 +307,10 @@ void World::readState(StateReader& in) {
 		b.shape = w.topologies_.intern(std::move(b.shape));
 	}
 	const int n = w.blockCount();
-	if (w.internalFaces_.size() > w.blocks_.size()) in.fail("more internal-face lists than blocks");
-	for (std::size_t b = 0; b < w.internalFaces_.size(); ++b)
-		if (!w.internalFaces_[b].empty() && w.internalFaces_[b].size() != w.blocks_[b].shape->faces.size())
+	const std::vector<std::vector<char>>& internalFaces = w.detection_.internalFaces();
+	if (internalFaces.size() > w.blocks_.size()) in.fail("more internal-face lists than blocks");
+	for (std::size_t b = 0; b < internalFaces.size(); ++b)
+		if (!internalFaces[b].empty() && internalFaces[b].size() != w.blocks_[b].shape->faces.size())
 			in.fail("internal faces of block " + std::to_string(b) + " do not match its faces");
 
 	in.tag("COLL");

@@ -1,0 +1,79 @@
+#include "InternalFaces.hpp"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+
+namespace dda {
+
+namespace {
+// Corner x lies in the convex polygon `face` of `vertices` (normal n,
+// counter-clockwise seen from outside), within `tolerance` [m].
+bool insidePolygon(const Vector3& x, const std::vector<Vector3>& vertices, const std::vector<int>& face,
+                   const Vector3& n, double tolerance) {
+	for (std::size_t k = 0; k < face.size(); ++k) {
+		const Vector3& p = vertices[face[k]];
+		const Vector3& q = vertices[face[(k + 1) % face.size()]];
+		const Vector3 inward = n.cross(q - p);
+		const double length = inward.norm();
+		if (length > 0 && (x - p).dot(inward) < -tolerance * length) return false;
+	}
+	return true;
+}
+
+// Marks the faces of bodies a and b that cover each other (see markInternalFaces).
+void markCoveredFaces(const PlacedPolyhedron& A, const PlacedPolyhedron& B, double tolerance,
+                      double parallelAngleTolerance, std::vector<char>& internalA, std::vector<char>& internalB) {
+	const std::vector<Vector3>& verticesA = *A.vertices;
+	const std::vector<Vector3>& verticesB = *B.vertices;
+	for (std::size_t f = 0; f < A.shape->faces.size(); ++f) {
+		const Vector3 nf = faceNormal(verticesA, A.shape->faces[f]);
+		const Vector3& pf = verticesA[A.shape->faces[f][0]];
+		for (std::size_t g = 0; g < B.shape->faces.size(); ++g) {
+			const Vector3 ng = faceNormal(verticesB, B.shape->faces[g]);
+			if (nf.dot(ng) > -1 + parallelAngleTolerance * parallelAngleTolerance) continue;
+			bool coplanar = true;
+			for (int v : B.shape->faces[g]) coplanar = coplanar && std::abs(nf.dot(verticesB[v] - pf)) <= tolerance;
+			if (!coplanar) continue;
+			bool fCovered = true, gCovered = true;
+			for (int v : A.shape->faces[f])
+				fCovered = fCovered && insidePolygon(verticesA[v], verticesB, B.shape->faces[g], ng, tolerance);
+			for (int v : B.shape->faces[g])
+				gCovered = gCovered && insidePolygon(verticesB[v], verticesA, A.shape->faces[f], nf, tolerance);
+			if (fCovered) internalA[f] = 1;
+			if (gCovered) internalB[g] = 1;
+		}
+	}
+}
+}  // namespace
+
+void markInternalFaces(const std::vector<PlacedPolyhedron>& bodies, double relativeLengthTolerance,
+                       double parallelAngleTolerance, std::vector<std::vector<char>>& internal) {
+	internal.assign(bodies.size(), {});
+	std::vector<int> given;
+	std::vector<Eigen::AlignedBox3d> boxes(bodies.size());
+	for (std::size_t b = 0; b < bodies.size(); ++b) {
+		if (!bodies[b].shape) continue;
+		given.push_back(static_cast<int>(b));
+		internal[b].assign(bodies[b].shape->faces.size(), 0);
+		for (const Vector3& x : *bodies[b].vertices) boxes[b].extend(x);
+	}
+	std::sort(given.begin(), given.end(), [&](int a, int b) { return boxes[a].min().x() < boxes[b].min().x(); });
+	for (std::size_t i = 0; i < given.size(); ++i) {
+		const int a = given[i];
+		for (std::size_t j = i + 1; j < given.size(); ++j) {
+			const int b = given[j];
+			const double tolerance =
+			    relativeLengthTolerance * std::max(boxes[a].diagonal().norm(), boxes[b].diagonal().norm());
+			if (boxes[b].min().x() > boxes[a].max().x() + tolerance) break;
+			Eigen::AlignedBox3d grown = boxes[a];
+			grown.min().array() -= tolerance;
+			grown.max().array() += tolerance;
+			if (!grown.intersects(boxes[b])) continue;
+			markCoveredFaces(bodies[a], bodies[b], tolerance, parallelAngleTolerance, internal[a], internal[b]);
+		}
+	}
+}
+
+}  // namespace dda

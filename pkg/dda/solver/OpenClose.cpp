@@ -1,0 +1,363 @@
+#include "OpenClose.hpp"
+
+#include "StepClock.hpp"
+#include "dda/core/CapacityBytes.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace dda {
+
+namespace {
+// A pass of the iteration has converged when, besides no state changing,
+// every contact's tangential force agrees with the model the last solve used
+// (a slipping contact's direction is linearised) to within this fraction of
+// the largest normal force of its group. Newton's method converges
+// quadratically there, so a tight tolerance costs about one solve more; at
+// 1e-4 the forces left over pushed a cube sliding along x sideways by 1e-7
+// m in a set-up symmetric in y.
+constexpr double kNewtonTolerance = 1e-10;
+// A step's friction limits are consistent with its normal forces when a pass
+// changes none by more than this fraction of the largest; a step makes at
+// most kLimitPasses passes (see solve()). Any limit >= 0 resists slip, so an
+// unsettled limit is an error in the friction's size, not in the energy.
+constexpr double kLimitTolerance = 1e-3;
+constexpr int kLimitPasses = 12;
+}  // namespace
+
+void OpenCloseIteration::selectMovingBlocks(const std::vector<Block>& blocks, const std::vector<char>& frozen,
+                                            StepStatistics& stats) {
+	const int count = static_cast<int>(blocks.size());
+	moving_.clear();
+	movingIndex_.assign(count, -1);
+	for (int i = 0; i < count; ++i) {
+		if (blocks[i].fixed || (!frozen.empty() && frozen[i])) continue;
+		movingIndex_[i] = static_cast<int>(moving_.size());
+		moving_.push_back(i);
+	}
+	const int n = static_cast<int>(moving_.size());
+	stats.movingBlocks = n;
+	stats.fixedBlocks = count - n;
+	blockUnknowns_.resize(n);
+	for (int k = 0; k < n; ++k) {
+		const Block& b = blocks[moving_[k]];
+		blockUnknowns_[k] = b.unknowns();
+		stats.unknowns += b.unknowns();
+		stats.rigidBlocks += b.rigid;
+		stats.strainUnknowns += b.unknowns() - kRigidBlockDofs;
+	}
+	solutions_.resize(n);
+}
+
+const Vector12& OpenCloseIteration::solutionOf(int block) const {
+	static const Vector12 zero = Vector12::Zero();
+	const int k = movingIndex_[block];
+	return k < 0 ? zero : iterate_[k];
+}
+
+bool OpenCloseIteration::solve(const std::vector<Block>& blocks, std::vector<Contact>& contacts,
+                               const IntegratorSettings& settings, double dt, bool firstStep, StepStatistics& stats) {
+	const Attempt attempt{blocks, contacts, settings, dt, stats};
+	// Open-close iteration: Newton's method on the step's energy (the
+	// blocks' quadratic energy plus every contact's compression-only
+	// normal spring and Coulomb-limited tangential spring; see
+	// ContactEquations.hpp), in passes. Within a pass each contact's
+	// friction limit is fixed, so the energy is one convex function:
+	// each solve minimises the contacts' model at the states of the
+	// current iterate, the states are evaluated at the new iterate, and
+	// once a contact has swung back (or the pass runs long) a line search
+	// makes every iterate lower the energy, so the pass cannot cycle. A
+	// pass has converged when no state changes and the slipping
+	// contacts' forces agree with their model: every closed contact is
+	// then in compression and every open one apart, exactly the
+	// gradients the energy account books, so the step creates no energy
+	// (World::accountStep). Then the limits are set from the normal
+	// forces found, and another pass is made while they change by more
+	// than kLimitTolerance (at most kLimitPasses). The hold-closed and
+	// friction-switch rules this replaces held contacts in tension and
+	// created energy (a stiff pile gained up to 36%).
+	startAttempt(attempt, firstStep);
+	bool converged = false, structureStale = true;
+	int iterations = 0, changes = 0;
+	while (iterations < std::max(1, settings.maxOpenCloseIterations)) {
+		solveOnce(attempt, structureStale);
+		++iterations;
+		group_.startIteration();
+		structureStale = evaluateStates(attempt);
+		measureLimits(contacts);
+		changes = 0;
+		if (closePasses(iterations, attempt, changes)) {
+			converged = true;
+			break;
+		}
+		if (startPasses(attempt)) structureStale = true;
+	}
+	solutions_ = iterate_;
+	stats.openCloseIterations = iterations;
+	stats.openCloseIterationsTotal += iterations;
+	stats.stateChanges = changes;
+	return converged;
+}
+
+void OpenCloseIteration::startAttempt(const Attempt& attempt, bool firstStep) {
+	const int n = static_cast<int>(moving_.size());
+	std::vector<Contact>& contacts = attempt.contacts;
+	// The blocks' own systems depend on dt: assembled anew in each attempt.
+	ownSystems_.clear();
+	ownSystemOf_.assign(n, -1);
+	solvedAlone_.assign(n, 0);
+	// assembleBlock adds a body force only for non-zero gravity.
+	if (!attempt.settings.gravity.isZero()) attempt.stats.bodyForceBlocks += n;
+	iterate_.assign(n, Vector12::Zero());
+	keptTerms_.clear();
+	keptTermsOf_.assign(contacts.size(), -1);
+	for (Contact& contact : contacts) {
+		startTrial(contact, firstStep);
+		const Block& blockI = attempt.blocks[contact.key.blockI];
+		const Block& blockJ = attempt.blocks[contact.key.blockJ];
+		// The first pass's limit from the normal force at the start of
+		// the step (its gap now), not the one the contact ended the last
+		// step with: a corner that bounced off keeps no friction.
+		evaluateContact(contact, blockI, blockJ, solutionOf(contact.key.blockI), solutionOf(contact.key.blockJ));
+		updateFrictionLimit(contact, true);
+		evaluateContact(contact, blockI, blockJ, solutionOf(contact.key.blockI), solutionOf(contact.key.blockJ));
+	}
+	computeStartAccelerations(attempt);
+	// The blocks that contacts join (open ones too: their energy counts
+	// once they close) form groups whose energies are independent: each
+	// group iterates, searches and converges on its own, so a block
+	// elsewhere in the scene cannot change another's trajectory, not even
+	// by round-off. A converged group's iterate is no longer moved.
+	groupContacts(contacts);
+	group_.reset(n);
+	for (const Contact& contact : contacts) group_.hasContacts[contactGroup_[&contact - contacts.data()]] = 1;
+}
+
+void OpenCloseIteration::solveOnce(const Attempt& attempt, bool structureStale) {
+	StepStatistics& stats = attempt.stats;
+	auto phase = Clock::now();
+	if (structureStale) {
+		buildSystemStructure(attempt);
+		assembleOwnSystems(attempt);
+	}
+	coupled_.reset(ownSystems_, ownSystemOf_);
+	assembleContacts(attempt);
+	stats.timeAssembly += secondsSince(phase);
+	phase = Clock::now();
+	// Which blocks are alone changes only with the structure.
+	if (structureStale) solveAloneBlocks(attempt);
+	coupled_.solve(solutions_, kMinBlocksForThreads);
+	stats.solvedUnknowns = coupled_.solvedUnknowns() + aloneUnknowns_;
+	if (lineSearch(attempt) < 1) ++stats.lineSearches;
+	stats.timeSolve += secondsSince(phase);
+}
+
+bool OpenCloseIteration::evaluateStates(const Attempt& attempt) {
+	bool structureStale = false;
+	std::vector<Contact>& contacts = attempt.contacts;
+	for (std::size_t c = 0; c < contacts.size(); ++c) {
+		Contact& contact = contacts[c];
+		const int g = contactGroup_[c];
+		if (group_.done[g]) continue;
+		const int bi = contact.key.blockI, bj = contact.key.blockJ;
+		const Block& blockI = attempt.blocks[bi];
+		const Block& blockJ = attempt.blocks[bj];
+		const Vector12& Di = solutionOf(bi);
+		const Vector12& Dj = solutionOf(bj);
+		const Vector3 model = tangentialForce(contact, blockI, blockJ, Di, Dj);
+		const double normalMiss = normalModelError(contact, Di, Dj);
+		const bool wasClosed = isClosed(contact);
+		if (evaluateContact(contact, blockI, blockJ, Di, Dj)) {
+			++group_.changes[g];
+			// Only closed contacts carry normal terms: opening and
+			// closing change which blocks the system couples.
+			if (wasClosed != isClosed(contact)) {
+				structureStale = true;
+				if (++contact.openCloseChanges >= 2) group_.swungBack[g] = 1;
+			}
+		}
+		// A contact that closes with no limit takes the limit of its
+		// normal force now, once per pass (so the pass's energy changes
+		// a finite number of times): frictionless until the next pass,
+		// a block landing on a much larger one was held sideways by its
+		// inertia alone, and the system's Cholesky failed on round-off
+		// at five decades of scale.
+		if (isClosed(contact) && !(contact.slipLimit > 0) && contact.trial.normalForce > 0 &&
+		    contact.frictionTangent > 0) {
+			updateFrictionLimit(contact, true);
+			evaluateContact(contact, blockI, blockJ, Di, Dj);
+			++group_.changes[g];
+		}
+		// The force scale of the group: its largest normal force, or
+		// friction limit (an open contact keeps its limit for the pass,
+		// so a group may slip with no normal force at all).
+		group_.largestNormalForce[g] =
+		    std::max({group_.largestNormalForce[g], std::abs(contact.trial.normalForce), contact.slipLimit});
+		group_.forceChange[g] = std::max(
+		    {group_.forceChange[g], normalMiss, (tangentialForce(contact, blockI, blockJ, Di, Dj) - model).norm()});
+	}
+	return structureStale;
+}
+
+void OpenCloseIteration::measureLimits(std::vector<Contact>& contacts) {
+	// Groups whose pass converged: their limits against the normal
+	// forces found; done when they agree, else another pass. (Limits
+	// that follow the normal forces at every solve instead, as Shi's
+	// friction does, settled most steps in fewer solves but cycled in
+	// others and, accepted unsettled, lost a sliding cube a fifth of
+	// its speed in its first step.)
+	for (std::size_t c = 0; c < contacts.size(); ++c) {
+		const int g = contactGroup_[c];
+		if (group_.done[g] || !group_.passConverged(g, kNewtonTolerance)) continue;
+		const double change = updateFrictionLimit(contacts[c], false);
+		group_.limitChange[g] = std::max(group_.limitChange[g], change);
+		group_.largestLimit[g] = std::max(group_.largestLimit[g], contacts[c].slipLimit + change);
+	}
+}
+
+bool OpenCloseIteration::closePasses(int iterations, const Attempt& attempt, int& changes) {
+	const int n = static_cast<int>(moving_.size());
+	StepStatistics& stats = attempt.stats;
+	bool allDone = true;
+	for (int g = 0; g < n; ++g) {
+		if (group_.done[g]) continue;
+		changes += group_.changes[g];
+		if (!group_.hasContacts[g]) {
+			group_.done[g] = 1;  // no contact: its own solve is its answer
+			continue;
+		}
+		const bool converged = group_.passConverged(g, kNewtonTolerance);
+		const bool settled = group_.limitChange[g] <= kLimitTolerance * group_.largestLimit[g];
+		// A converged pass is accepted with its limits unsettled after
+		// kLimitPasses passes, or once three quarters of the step's
+		// solves are spent: it is energy-safe (every limit >= 0
+		// dissipates), and a cut would throw every solve away. In a
+		// pile of 30 stiff cubes a contact's limit can swing between
+		// its closed and open values pass after pass.
+		const bool late = iterations >= (3 * attempt.settings.maxOpenCloseIterations) / 4;
+		if (converged && (settled || late || group_.passes[g] + 1 >= kLimitPasses)) {
+			group_.done[g] = 1;
+			if (!settled) ++stats.limitsUnsettled;
+			continue;
+		}
+		allDone = false;
+		if (!converged) continue;
+		group_.newPass[g] = 1;
+		++group_.passes[g];
+		++stats.limitPasses;
+		group_.passSolves[g] = 0;
+	}
+	return allDone;
+}
+
+bool OpenCloseIteration::startPasses(const Attempt& attempt) {
+	bool structureStale = false;
+	std::vector<Contact>& contacts = attempt.contacts;
+	for (std::size_t c = 0; c < contacts.size(); ++c) {
+		Contact& contact = contacts[c];
+		if (!group_.newPass[contactGroup_[c]]) continue;
+		// Which contacts carry terms may change with the limits (an
+		// open contact with a limit keeps its tangential spring).
+		const bool hadTerms = isClosed(contact) || contact.slipLimit > 0;
+		updateFrictionLimit(contact, true);
+		if (hadTerms != (isClosed(contact) || contact.slipLimit > 0)) structureStale = true;
+		const int bi = contact.key.blockI, bj = contact.key.blockJ;
+		evaluateContact(contact, attempt.blocks[bi], attempt.blocks[bj], solutionOf(bi), solutionOf(bj));
+	}
+	return structureStale;
+}
+
+void OpenCloseIteration::groupContacts(const std::vector<Contact>& contacts) {
+	const int n = static_cast<int>(moving_.size());
+	std::vector<int>& root = groupRoot_;
+	root.resize(n);
+	for (int k = 0; k < n; ++k) root[k] = k;
+	auto find = [&](int k) {
+		while (root[k] != k) k = root[k] = root[root[k]];
+		return k;
+	};
+	for (const Contact& contact : contacts) {
+		const int mi = movingIndex_[contact.key.blockI], mj = movingIndex_[contact.key.blockJ];
+		if (mi < 0 || mj < 0) continue;
+		const int a = find(mi), b = find(mj);
+		if (a != b) root[std::max(a, b)] = std::min(a, b);
+	}
+	for (int k = 0; k < n; ++k) root[k] = find(k);
+	contactGroup_.resize(contacts.size());
+	for (std::size_t c = 0; c < contacts.size(); ++c) {
+		const int mi = movingIndex_[contacts[c].key.blockI];
+		contactGroup_[c] = root[mi >= 0 ? mi : movingIndex_[contacts[c].key.blockJ]];
+	}
+}
+
+void OpenCloseIteration::GroupIteration::reset(int groups) {
+	done.assign(groups, 0);
+	hasContacts.assign(groups, 0);
+	swungBack.assign(groups, 0);
+	passes.assign(groups, 0);
+	passSolves.assign(groups, 0);
+	changes.assign(groups, 0);
+	newPass.assign(groups, 0);
+	forceChange.assign(groups, 0.0);
+	largestNormalForce.assign(groups, 0.0);
+	limitChange.assign(groups, 0.0);
+	largestLimit.assign(groups, 0.0);
+}
+
+void OpenCloseIteration::GroupIteration::startIteration() {
+	for (std::size_t g = 0; g < done.size(); ++g) {
+		if (done[g]) continue;
+		++passSolves[g];
+		changes[g] = 0;
+		newPass[g] = 0;
+		forceChange[g] = largestNormalForce[g] = limitChange[g] = largestLimit[g] = 0;
+	}
+}
+
+std::size_t OpenCloseIteration::GroupIteration::memoryBytes() const {
+	return capacityBytes(done) + capacityBytes(hasContacts) + capacityBytes(swungBack) + capacityBytes(newPass) +
+	       capacityBytes(passes) + capacityBytes(passSolves) + capacityBytes(changes) + capacityBytes(forceChange) +
+	       capacityBytes(largestNormalForce) + capacityBytes(limitChange) + capacityBytes(largestLimit);
+}
+
+bool OpenCloseIteration::GroupIteration::passConverged(int g, double tolerance) const {
+	return changes[g] == 0 && forceChange[g] <= tolerance * largestNormalForce[g];
+}
+
+const Vector12& OpenCloseIteration::startAccelerationOf(int k) const {
+	static const Vector12 zero = Vector12::Zero();
+	return startAccelerations_.empty() ? zero : startAccelerations_[k];
+}
+
+void OpenCloseIteration::computeStartAccelerations(const Attempt& attempt) {
+	const int n = static_cast<int>(moving_.size());
+	startAccelerations_.clear();
+	if (attempt.settings.shiScheme()) return;
+	startAccelerations_.resize(n);
+	for (int k = 0; k < n; ++k) {
+		const Block& block = attempt.blocks[moving_[k]];
+		startAccelerations_[k] = accelerationOf(block, restForce(block, attempt.settings));
+	}
+}
+
+double OpenCloseIteration::largestDisplacement(const std::vector<Block>& blocks) const {
+	const int n = static_cast<int>(moving_.size());
+	double largest = 0;
+#pragma omp parallel for schedule(static) reduction(max : largest) if (n >= kMinBlocksForThreads)
+	for (int k = 0; k < n; ++k) largest = std::max(largest, largestVertexDisplacement(blocks[moving_[k]], solutions_[k]));
+	return largest;
+}
+
+std::size_t OpenCloseIteration::memoryBytes() const {
+	return coupled_.memoryBytes() + capacityBytes(moving_) + capacityBytes(movingIndex_) +
+	       capacityBytes(solutions_) + capacityBytes(ownSystems_) + capacityBytes(ownSystemOf_) +
+	       capacityBytes(solvedAlone_) + capacityBytes(links_) + capacityBytes(hasSprings_) +
+	       capacityBytes(blockUnknowns_) + capacityBytes(iterate_) + capacityBytes(deltas_) + capacityBytes(lines_) +
+	       capacityBytes(groupRoot_) + capacityBytes(lineGroup_) + capacityBytes(groupLines_) +
+	       capacityBytes(orderedLines_) + capacityBytes(keptTerms_) + capacityBytes(keptTermsOf_) +
+	       capacityBytes(keptTermsKey_) + capacityBytes(groupKink_) + capacityBytes(groupSlope_) +
+	       capacityBytes(groupCurvature_) + capacityBytes(groupStep_) + capacityBytes(contactGroup_) +
+	       capacityBytes(startAccelerations_) + group_.memoryBytes();
+}
+
+}  // namespace dda

@@ -1,0 +1,50 @@
+// Time-step control of World::step: the dt each step tries first (the last
+// accepted one x timeStepGrowth, at most maxTimeStep), the largest vertex
+// displacement a step may make, and the cuts of an attempt that did not
+// converge (dt x openCloseShrink) or moved too far (dt x clamp(safety x
+// allowed / largest, minTimeStepShrink, maxTimeStepShrink)), up to
+// maxStepCuts (IntegratorSettings.hpp has the rules' parameters). Counts the
+// steps accepted unconverged or beyond the bound.
+#pragma once
+
+#include "IntegratorSettings.hpp"
+
+namespace dda {
+
+class StateWriter;
+class StateReader;
+
+class TimeStepControl {
+public:
+	// Largest vertex displacement allowed in one step [m]: maxDisplacement, or
+	// without it maxDisplacementRatio x sceneHalfSize() (Shi's g2 x w0) [m].
+	// sceneHalfSize is called only then (World measures w0 when first asked).
+	template <class SceneHalfSize>
+	static double allowedDisplacement(const IntegratorSettings& settings, SceneHalfSize&& sceneHalfSize) {
+		return settings.maxDisplacement > 0 ? settings.maxDisplacement
+		                                    : settings.maxDisplacementRatio * sceneHalfSize();
+	}
+	// The dt a step tries first [s].
+	double firstTry(const IntegratorSettings& settings) const;
+	// After attempt number `attempt` (0 first) at dt: whether it is accepted;
+	// else dt is cut for the next attempt. `largest` is its largest vertex
+	// displacement [m]; the cuts are counted in stats.
+	bool accept(int attempt, bool converged, double largest, const IntegratorSettings& settings, double& dt,
+	            StepStatistics& stats);
+	// The step was taken at dt: the next tries dt x timeStepGrowth.
+	void stepTaken(const IntegratorSettings& settings, double dt);
+	// The next step tries dt [s] first (settling's static steps).
+	void setNextTry(double dt) { nextTimeStep_ = dt; }
+	long displacementLimitMisses() const { return displacementLimitMisses_; }
+	long openCloseFailures() const { return openCloseFailures_; }
+	// Saving (World::writeState / readState): next dt, failures, misses.
+	void writeState(StateWriter& out) const;
+	void readState(StateReader& in);
+
+private:
+	double nextTimeStep_ = 0;  // dt to try first in the next step; 0 = maxTimeStep
+	long openCloseFailures_ = 0;
+	long displacementLimitMisses_ = 0;
+};
+
+}  // namespace dda
