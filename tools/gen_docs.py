@@ -18,7 +18,7 @@ TARGET = os.path.join(REPO, 'doc', 'parameters.md')
 
 def render():
     """The text of doc/parameters.md for the yade_dda that Python imports."""
-    from yade_dda import engines
+    from yade_dda import params
     lines = [
         '# Parameter reference',
         '',
@@ -32,12 +32,12 @@ def render():
         'refused when it is set (ValueError naming the parameter, the range and the value); the rules '
         'between parameters (%s) are checked when the engine steps. The C++ core reads the same settings '
         'as `dda::IntegratorSettings`, member for member, under the name in the last column.'
-        % engines.RULES.replace('``', '`'), 90) + [
+        % params.RULES.replace('``', '`'), 90) + [
         '',
         '| parameter | default | range | unit | meaning | C++ |',
         '|---|---|---|---|---|---|',
     ]
-    for row in engines._SETTINGS:
+    for row in params.SETTINGS:
         if row['kind'] in ('real', 'integer', 'choice'):
             allowed = row['range']
         elif row['kind'] == 'vector':

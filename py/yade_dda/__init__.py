@@ -10,20 +10,42 @@ advanced by Shi's implicit time scheme. A script reads like any YADE script::
     O.run(1000, True)
 
 All quantities are SI: metres, seconds, kilograms, pascals, newtons, radians.
+
+``from yade_dda import *`` gives what a scene script uses (``__all__``). The
+bench tools stay out of it and load when first asked for:
+``yade_dda.compareColliders`` (yade_dda.compare), ``yade_dda.sweep``
+(yade_dda.accuracy) and ``from yade_dda import regression``.
 """
-from . import _yade
 from ._yade import O
-from . import guards  # noqa: F401  (O.bodies.erase/clear guards for DDA blocks)
+from .hooks import installHooks
 from .blocks import ddaBlock, rigidBlock
 from .engines import DDAIntegrator
 from .colliders import MSCCollider, DESSCollider, NBSCollider, AllPairsCollider
-from .compare import compareColliders
 from .saveload import Checkpoint, latestCheckpoint, writeCheckpoint, storeState, restoreState
-from .accuracy import sweep
 from .scene import (stats, sync, block, blockOf, setVelocity, addPointLoad, addFixedPoint,
                     printStats, contacts, Ig2_DDABlock_DDABlock_DDAContact)
 
+installHooks()
+
 __all__ = ['ddaBlock', 'rigidBlock', 'DDAIntegrator', 'MSCCollider', 'DESSCollider', 'NBSCollider', 'AllPairsCollider',
-           'compareColliders', 'Checkpoint', 'latestCheckpoint', 'sweep', 'stats', 'printStats', 'sync', 'block',
-           'blockOf',
+           'Checkpoint', 'latestCheckpoint', 'stats', 'printStats', 'sync', 'block', 'blockOf',
            'setVelocity', 'addPointLoad', 'addFixedPoint', 'contacts', 'Ig2_DDABlock_DDABlock_DDAContact', 'O']
+
+_TOOLS = ('compare', 'accuracy', 'regression', 'compareColliders', 'sweep')
+"""Bench tools: attributes of the package, loaded on first use, out of ``import *``."""
+
+
+def __getattr__(name):
+    """Loads a bench tool (see _TOOLS) on first use (PEP 562). (Importing a
+    submodule makes it an attribute of the package; ``from . import compare``
+    would ask this function again.)"""
+    if name in ('compare', 'compareColliders'):
+        from .compare import compareColliders
+        return compareColliders if name == 'compareColliders' else globals()['compare']
+    if name in ('accuracy', 'sweep'):
+        from .accuracy import sweep
+        return sweep if name == 'sweep' else globals()['accuracy']
+    if name == 'regression':
+        from .regression import versions  # noqa: F401
+        return globals()['regression']
+    raise AttributeError('module %r has no attribute %r' % (__name__, name))

@@ -45,6 +45,8 @@ import time
 
 from ._yade import O
 from . import engines as _engines
+from .colliders import MSCCollider
+from .scene import stats
 
 # knob name -> (engine class name, parameter name, unit)
 KNOBS = {
@@ -81,7 +83,6 @@ class _Monitor:
 
     def step(self):
         start = time.perf_counter()
-        from .scene import stats
         s = stats()
         self.steps += 1
         for key in _SUMMED:
@@ -112,7 +113,6 @@ def knobEngine(knob):
     found = [e for e in engines if type(e).__name__ == cls]
     if found:
         return found[0], param
-    from .colliders import MSCCollider
     engine = MSCCollider(label='collider')
     engines.insert(integrators[0], engine)
     O.engines = engines
@@ -157,7 +157,6 @@ def advance(tEnd, budgetFactor=1000):
 def runPoint(build, measure, tEnd, settings=None, monitor=None):
     """One run: O.reset(), build(), engine settings {knob: value}, advance to
     tEnd [s], measure(). Returns the point dict (see the module docstring)."""
-    from .scene import stats
     O.reset()
     build()
     settings = dict(settings or {})

@@ -4,6 +4,7 @@ import math
 from ._yade import O, utils, wrapper
 from . import _core
 from . import scene as _scene
+from .params import vector
 
 
 class BlockSpec:
@@ -24,19 +25,6 @@ class BlockSpec:
             return self.points
         x, y, z = self.shift
         return [(p[0] + x, p[1] + y, p[2] + z) for p in self.points]
-
-
-def _vector(value, what, length=3):
-    try:
-        values = [float(x) for x in value]
-    except (TypeError, ValueError):
-        raise TypeError('%s must be a sequence of %d numbers, got %r' % (what, length, value)) from None
-    if len(values) != length:
-        raise ValueError('%s must have %d components, got %d' % (what, length, len(values)))
-    for i, x in enumerate(values):
-        if not math.isfinite(x):
-            raise ValueError('%s has a non-finite component %d: %r' % (what, i, x))
-    return tuple(values)
 
 
 def _finiteNonNegative(value, what, unit):
@@ -194,8 +182,8 @@ def ddaBlock(vertices, material=None, fixed=False, color=None, velocity=(0, 0, 0
     cohesion = _finiteNonNegative(cohesion, 'cohesion', 'Pa')
     tensileStrength = _finiteNonNegative(tensileStrength, 'tensileStrength', 'Pa')
     _core.checkBlock(points, density, young, poisson, frictionAngle, cohesion, tensileStrength)
-    velocity = _vector(velocity, 'velocity')
-    angularVelocity = _vector(angularVelocity, 'angularVelocity')
+    velocity = vector(velocity, 'velocity')
+    angularVelocity = vector(angularVelocity, 'angularVelocity')
     if fixed and (any(velocity) or any(angularVelocity)):
         raise ValueError('a fixed block cannot have an initial velocity')
     try:
@@ -212,7 +200,7 @@ def ddaBlock(vertices, material=None, fixed=False, color=None, velocity=(0, 0, 0
             point, stiffness = entry
         else:
             point, stiffness = entry, 0.0
-        point = _vector(point, 'fixed point %d' % i)
+        point = vector(point, 'fixed point %d' % i)
         stiffness = _finiteNonNegative(stiffness, 'fixed point %d stiffness' % i, 'N/m')
         fixedList.append((point, stiffness))
     loadList = []
@@ -221,16 +209,16 @@ def ddaBlock(vertices, material=None, fixed=False, color=None, velocity=(0, 0, 0
             point, force = entry
         except (TypeError, ValueError):
             raise TypeError('load %d must be a pair (point [m], force [N]), got %r' % (i, entry)) from None
-        loadList.append((_vector(point, 'load %d point' % i), _vector(force, 'load %d force' % i)))
+        loadList.append((vector(point, 'load %d point' % i), vector(force, 'load %d force' % i)))
     if stress is not None:
-        stress = _vector(stress, 'stress', 6)
+        stress = vector(stress, 'stress', 6)
         if rigid and any(stress):
             raise ValueError('a rigid block has no strain and carries no stress; got stress=%r [Pa] with rigid=True '
                              '(make the block deformable, or drop the stress)' % (stress,))
     if not isinstance(mask, int) or isinstance(mask, bool):
         raise TypeError('mask must be an int, got %r' % (mask,))
     if color is not None:
-        color = _vector(color, 'color')
+        color = vector(color, 'color')
 
     # YADE's shape is made from the corners shifted near the origin (see _nearOrigin); the body is then put
     # back: pos = shift + YADE's centroid (rounded; SceneLink's vertex match allows for it). The spec keeps

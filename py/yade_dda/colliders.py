@@ -17,11 +17,11 @@ carries every parameter, so an engine that comes back from
 """
 from ._yade import O, wrapper
 from . import _core
-from . import engines as _engines
+from . import guards as _guards
+from . import params as _settings
 from . import scene as _scene
-from .engines import _Parameter, _finite, _initEngine
-
-_COMMAND = 'import yade_dda.colliders as _ddac; _ddac._select('
+from .guards import COLLIDER_COMMAND
+from .params import Parameter, finite, initEngine
 
 
 def _select(name, **parameters):
@@ -30,34 +30,16 @@ def _select(name, **parameters):
     Called by the collider engines' commands; DDAIntegrator's step of the
     same iteration uses it instead of its own ``collider`` parameter.
     """
-    if name not in _engines._COLLIDERS:
+    if name not in _settings.COLLIDERS:
         raise ValueError('collider %r is not available in this build (available: %s)'
-                         % (name, ', '.join(_engines._COLLIDERS)))
+                         % (name, ', '.join(_settings.COLLIDERS)))
     scene = _scene.current()
     previous = getattr(scene, 'colliderChoice', None)
     if previous is None or previous[0] != O.iter - 1:
-        _checkOrder()   # first call, or the engine list may have changed
+        _guards.checkColliderOrder(O.engines)   # first call, or the engine list may have changed
     # (iteration, strategy, its parameters): honoured by integratorStep at this iteration only,
     # so removing the collider engine returns the choice to DDAIntegrator.collider.
     scene.colliderChoice = (O.iter, name, parameters)
-
-
-def _checkOrder():
-    """A collider engine must run before DDAIntegrator, and only one may be in O.engines."""
-    colliders, integrator = [], None
-    for index, engine in enumerate(O.engines):
-        if isinstance(engine, wrapper.PyRunner) and not engine.dead:
-            if engine.command.startswith(_COMMAND):
-                colliders.append(index)
-            elif engine.command.startswith('import yade_dda.engines') and integrator is None:
-                integrator = index
-    if len(colliders) > 1:
-        raise RuntimeError('O.engines holds %d DDA collider engines (at positions %s); keep one'
-                           % (len(colliders), ', '.join(map(str, colliders))))
-    if colliders and integrator is not None and integrator < colliders[0]:
-        raise RuntimeError('the DDA collider engine (O.engines[%d]) must come before DDAIntegrator '
-                           '(O.engines[%d]), as YADE colliders come before the interaction loop'
-                           % (colliders[0], integrator))
 
 
 class _ColliderEngine(wrapper.PyRunner):
@@ -68,7 +50,7 @@ class _ColliderEngine(wrapper.PyRunner):
 
     def __init__(self, label='', **params):
         wrapper.PyRunner.__init__(self)
-        _initEngine(self, label, params)
+        initEngine(self, label, params)
 
     @property
     def strategy(self):
@@ -77,7 +59,7 @@ class _ColliderEngine(wrapper.PyRunner):
 
     def _updateCommand(self):
         args = ''.join(', %s=%r' % (name, self._params[name]) for name in self._names)
-        self.command = '%s%r%s)' % (_COMMAND, self._strategy, args)
+        self.command = '%s%r%s)' % (COLLIDER_COMMAND, self._strategy, args)
 
 
 class DESSCollider(_ColliderEngine):
@@ -141,7 +123,7 @@ class AllPairsCollider(_ColliderEngine):
 
 
 def _criticalLength(value):
-    return _finite('criticalLength', value, 0, unit=' m')
+    return finite('criticalLength', value, 0, unit=' m')
 
 
 def _segments(value):
@@ -171,7 +153,7 @@ class MSCCollider(_ColliderEngine):
     - ``segments``: N, the number of segments a long edge is divided into
       (default 3, >= 1).
 
-    Until the core provides MSC (``'MSC'`` in ``yade_dda.engines._COLLIDERS``)
+    Until the core provides MSC (``'MSC'`` in ``yade_dda.params.COLLIDERS``)
     the constructor raises NotImplementedError; use DESSCollider meanwhile.
 
     Example::
@@ -182,21 +164,21 @@ class MSCCollider(_ColliderEngine):
 
     _strategy = 'MSC'
     _names = ('criticalLength', 'segments')
-    criticalLength = _Parameter(0.0, _criticalLength, 'lambda [m]: edges longer than this are divided; 0 = 3 x block size')
-    segments = _Parameter(3, _segments, 'N: segments per divided edge')
+    criticalLength = Parameter(0.0, _criticalLength, 'lambda [m]: edges longer than this are divided; 0 = 3 x block size')
+    segments = Parameter(3, _segments, 'N: segments per divided edge')
 
     def __init__(self, label='', **params):
-        if 'MSC' not in _engines._COLLIDERS:
+        if 'MSC' not in _settings.COLLIDERS:
             raise NotImplementedError(
                 'MSCCollider: the multi-shell cover collider is not in this build of the DDA core yet '
                 '(available broad phases: %s). Use DESSCollider (same contacts) until it is.'
-                % ', '.join(_engines._COLLIDERS))
+                % ', '.join(_settings.COLLIDERS))
         _ColliderEngine.__init__(self, label, **params)
 
 
 def available():
     """Names of the broad phases this build of the core provides, e.g. ('DESS', 'NBS', 'AllPairs')."""
-    return tuple(_engines._COLLIDERS)
+    return tuple(_settings.COLLIDERS)
 
 
 ENGINES = {engine._strategy: engine for engine in (MSCCollider, DESSCollider, NBSCollider, AllPairsCollider)}

@@ -16,15 +16,16 @@ import statistics
 import time
 
 from ._yade import O, utils, wrapper
-from . import engines as _engines
 from . import colliders as _colliders
+from . import params as _settings
+from .params import finite
 from .blocks import ddaBlock
 from .engines import DDAIntegrator
 from . import scene as _scene
 from .scene import stats as _stats
 
 # The core's broad phases, MSC (the paper's method, the comparison's reference) first.
-OURS = ('MSC',) + tuple(name for name in _engines._COLLIDERS if name != 'MSC')
+OURS = ('MSC',) + tuple(name for name in _settings.COLLIDERS if name != 'MSC')
 YADE_COLLIDERS = ('InsertionSortCollider', 'SpatialQuickSortCollider')
 DEFAULT_OUT = os.path.join('bench', 'out', 'compare_colliders.json')
 _POLYHEDRA_LOGGER = 'Polyhedra_support.cpp'   # YADE's logger of its polyhedron intersection
@@ -304,7 +305,7 @@ def compareColliders(blocks, steps=100, dt=1e-3, gravity=(0, 0, -9.81), strategi
     steps = int(steps)
     if steps < 1:
         raise ValueError('steps must be >= 1, got %r' % (steps,))
-    dt = _engines._finite('dt', dt, 0, lowOpen=True, unit=' s')
+    dt = finite('dt', dt, 0, lowOpen=True, unit=' s')
     gravity = tuple(float(g) for g in gravity)
     strategies = tuple(strategies)
     for name in strategies:

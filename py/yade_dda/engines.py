@@ -6,7 +6,6 @@ The command string carries every parameter, so an engine that comes back from
 ``O.save()``/``O.load()`` as a plain PyRunner still knows its settings.
 """
 import ast
-import math
 import sys
 import textwrap
 import time
@@ -15,149 +14,7 @@ from ._yade import O, wrapper
 from . import _core
 from . import guards as _guards
 from . import scene as _scene
-from .blocks import _vector
-
-
-def _finite(name, value, low=None, high=None, lowOpen=False, unit='', highOpen=False, bounds=None):
-    """float(value) if it is finite and in the range from low to high (None: unbounded;
-    lowOpen, highOpen: that end excluded); else TypeError or ValueError naming the
-    parameter, the range (bounds: its text, by default made from the ends) and the value."""
-    if isinstance(value, bool):
-        raise TypeError('%s must be a number, got %r' % (name, value))
-    try:
-        value = float(value)
-    except (TypeError, ValueError):
-        raise TypeError('%s must be a number, got %r' % (name, value)) from None
-    ok = math.isfinite(value)
-    if ok and low is not None:
-        ok = value > low if lowOpen else value >= low
-    if ok and high is not None:
-        ok = value < high if highOpen else value <= high
-    if not ok:
-        if bounds is None:
-            bounds = '%s%s, %s' % ('(' if lowOpen else '[', low, '%s%s' % (high, ')' if highOpen else ']')
-                                   if high is not None else 'inf)')
-        raise ValueError('%s must be finite and in %s, got %r%s' % (name, bounds, value, unit))
-    return value
-
-
-class _Parameter:
-    """A typed engine parameter: default, unit, validation; stored in the command."""
-
-    def __init__(self, default, check, doc):
-        self.default, self.check, self.__doc__ = default, check, doc
-
-    def __set_name__(self, owner, name):
-        self.name = name
-
-    @classmethod
-    def fromRow(cls, row):
-        """The parameter of a row of _core.settingsTable() (pkg/dda/solver/Settings.def)."""
-        parameter = cls(row['default'], _check(row), row['doc'])
-        parameter.name = row['name']
-        return parameter
-
-    def __get__(self, engine, owner=None):
-        if engine is None:
-            return self
-        return engine._params[self.name]
-
-    def __set__(self, engine, value):
-        engine._params[self.name] = self.check(value)
-        engine._updateCommand()
-
-
-_COLLIDERS = tuple(_core.colliderNames())   # the core's broad phases (pkg/dda/collider/ColliderFactory.cpp)
-
-
-_INT_MAX = 2 ** 31 - 1   # the core's counters are C ints
-
-
-def _integer(name, low, high=_INT_MAX, bounds=None):
-    """Validator of an integer parameter in [low, high]; rejects 1.5, '3', True."""
-    def check(value):
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or value != int(value):
-            raise TypeError('%s must be an integer, got %r' % (name, value))
-        if not low <= value <= high:
-            raise ValueError('%s must be an integer in %s, got %r' % (name, bounds or '[%d, %d]' % (low, high), value))
-        return int(value)
-    return check
-
-
-def _choice(name, choices):
-    def check(value):
-        if value not in choices:
-            raise ValueError('%s must be one of %s, got %r' % (name, ', '.join(choices), value))
-        return value
-    return check
-
-
-def _check(row):
-    """The validator of a row of _core.settingsTable(), by its kind; the range and its
-    text come from the row."""
-    name, kind = row['name'], row['kind']
-    if kind == 'real':
-        unit = '' if row['unit'] in ('', '-') else ' ' + row['unit']
-        return lambda value: _finite(name, value, row['low'], row['high'], row['lowOpen'], unit, row['highOpen'],
-                                     row['range'])
-    if kind == 'integer':
-        return _integer(name, max(row['low'], -_INT_MAX - 1), min(row['high'], _INT_MAX), row['range'])
-    if kind == 'boolean':
-        return bool
-    if kind == 'vector':
-        return _vector3(name)
-    if kind == 'choice':
-        return _choice(name, row['choices'])
-    raise TypeError('setting %s has an unknown kind %r' % (name, kind))
-
-
-def _initEngine(engine, label, params):
-    """Checks and stores an engine's typed parameters (its class's ``_names``,
-    each a _Parameter), runs it every step from the first, sets the label and
-    writes the command. Unknown names raise TypeError naming them."""
-    names = type(engine)._names
-    unknown = set(params) - set(names)
-    if unknown:
-        raise TypeError('%s has no parameter %s%s' % (
-            type(engine).__name__, ', '.join(sorted(unknown)),
-            ' (parameters: %s)' % ', '.join(names) if names else ' (it takes none but label)'))
-    engine._params = {}
-    for name in names:
-        descriptor = type(engine).__dict__[name]
-        engine._params[name] = descriptor.check(params.get(name, descriptor.default))
-    if not isinstance(label, str):
-        raise TypeError('label must be a string, got %r' % (label,))
-    engine.iterPeriod = 1
-    engine.initRun = True
-    if label:
-        engine.label = label
-    engine._updateCommand()
-
-
-def _vector3(name):
-    return lambda value: _vector(value, name)
-
-
-_SETTINGS = _core.settingsTable()
-"""Every DDAIntegrator parameter, from the core's one declaration of the settings
-(pkg/dda/solver/Settings.def): dicts with name, member (the IntegratorSettings
-attribute, None for the engine's own), kind, default, range (and low, high,
-lowOpen, highOpen or choices), unit, doc."""
-
-
-RULES = '``newmarkBeta = newmarkGamma / 2``, ``minTimeStepShrink <= maxTimeStepShrink``'
-"""The rules between settings that validateSettings (pkg/dda/solver/Settings.cpp) checks at each step."""
-
-
-def parameterLine(row):
-    """'``dt`` [s], default 0.001, in (0, inf): largest time step; ...' for docstrings."""
-    unit = ' [%s]' % row['unit'] if row['unit'] else ''
-    where = ''
-    if row['kind'] in ('real', 'integer'):
-        where = ', in %s' % row['range']
-    elif row['kind'] == 'choice':
-        where = ', %s' % row['range']
-    return '``%s``%s, default %r%s: %s' % (row['name'], unit, row['default'], where, row['doc'])
+from .params import Parameter, RULES, SETTINGS, initEngine, parameterLine
 
 
 _INTEGRATOR_DOC = """Shi's implicit DDA time integration of all DDA blocks, with their contacts
@@ -190,16 +47,16 @@ _INTEGRATOR_DOC = """Shi's implicit DDA time integration of all DDA blocks, with
         O.engines = [DDAIntegrator(dt=1e-3, gravity=(0, 0, -9.81), label='dda')]
         O.run(1000, True)
     """ % (RULES, '\n'.join(textwrap.fill(parameterLine(row), 79, initial_indent='    - ', subsequent_indent='      ')
-                               for row in _SETTINGS))
+                               for row in SETTINGS))
 
 
 class DDAIntegrator(wrapper.PyRunner):
     __doc__ = _INTEGRATOR_DOC
-    _names = tuple(row['name'] for row in _SETTINGS)
+    _names = tuple(row['name'] for row in SETTINGS)
 
     def __init__(self, label='', **params):
         wrapper.PyRunner.__init__(self)
-        _initEngine(self, label, params)
+        initEngine(self, label, params)
 
     @classmethod
     def _defaults(cls):
@@ -213,8 +70,8 @@ class DDAIntegrator(wrapper.PyRunner):
         self.command = 'import yade_dda.engines as _dda; _dda.integratorStep(%r)' % (repr(changed),)
 
 
-for _row in _SETTINGS:
-    setattr(DDAIntegrator, _row['name'], _Parameter.fromRow(_row))
+for _row in SETTINGS:
+    setattr(DDAIntegrator, _row['name'], Parameter.fromRow(_row))
 
 
 _paramsCache = {}
@@ -232,7 +89,7 @@ def _parse(text):
 
 def _settings(params):
     settings = _core.IntegratorSettings()
-    for row in _SETTINGS:
+    for row in SETTINGS:
         if row['member'] is not None:
             setattr(settings, row['member'], params[row['name']])
     return settings
@@ -275,8 +132,7 @@ def _isOwnCommand(engine):
 def _checkEngines(scene, engines):
     """Refuses engine lists that would move DDA blocks twice, or make YADE contacts with them."""
     _guards.checkSingleIntegrator(engines)
-    from .colliders import _checkOrder   # (colliders imports this module)
-    _checkOrder()   # here too: a collider engine after us would run only after our step
+    _guards.checkColliderOrder(engines)   # here too: a collider engine after us would run only after our step
     _guards.checkYadeContacts(scene, engines)
     for engine in engines:
         if isinstance(engine, wrapper.NewtonIntegrator):

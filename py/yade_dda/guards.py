@@ -7,7 +7,8 @@
   DDA state of the scene, and ``O.bodies.replace(bodies)`` clears it and
   makes the DDA blocks among ``bodies`` the new scene's blocks (they enter
   the core at the next step). Blocks made by ``ddaBlock()`` but not yet
-  appended stay appendable across both.
+  appended stay appendable across both. (Wrappers installed on YADE's
+  ``BodyContainer`` by ``yade_dda.installHooks``, in hooks.py.)
 - Blocks entering the scene overlapping deeper than the initial-overlap
   tolerance (dda/solver/InitialOverlaps.hpp) are refused with the two body
   ids and the depth; nothing is added and no step is taken.
@@ -18,71 +19,12 @@
   a DDA block would make YADE contacts DDA never sees: refused, with the
   mask bits to change.
 """
-import uuid
-
 from ._yade import O, wrapper
-from . import scene as _scene
 
-_INTEGRATOR_COMMAND = 'import yade_dda.engines'
-
-
-# ------------------------------------------------------------------ erasing bodies
-
-_originalErase = wrapper.BodyContainer.erase
-_originalClear = wrapper.BodyContainer.clear
-_originalReplace = wrapper.BodyContainer.replace
-
-
-def _erase(self, id, *args, **kw):
-    scene = _scene.current(create=False)
-    if scene is not None and isinstance(id, int):
-        index = scene.core.blockOfBody(id)
-        if index is not None:
-            raise RuntimeError(
-                'body %d is DDA block %d of a running scene; the DDA core cannot remove blocks yet, so it was not '
-                'erased. Erase DDA blocks before the first step after their append, or rebuild the scene '
-                '(O.reset()).' % (id, index))
-        scene.pending = [(body, spec) for body, spec in scene.pending if body.id != id]
-    return _originalErase(self, id, *args, **kw)
-
-
-def _freshScene(bodies=()):
-    """Replaces the current DDA scene (its blocks are gone from O.bodies) by an
-    empty one that keeps the pending blocks among `bodies` and those made by
-    ddaBlock() but never appended (id < 0).
-    (O.tags has no __delitem__, so the token is replaced rather than removed.)"""
-    old = _scene.current(create=False)
-    if old is None:
-        return
-    kept = {id(body) for body in bodies}
-    token = uuid.uuid4().hex
-    fresh = _scene.DDAScene(token)
-    fresh.pending = [(body, spec) for body, spec in old.pending if body.id < 0 or id(body) in kept]
-    _scene._scenes.pop(old.token, None)
-    _scene._scenes[token] = fresh
-    O.tags[_scene.TAG] = token
-
-
-def _clear(self, *args, **kw):
-    result = _originalClear(self, *args, **kw)
-    _freshScene()
-    return result
-
-
-def _replace(self, bodies, *args, **kw):
-    bodies = list(bodies)
-    # YADE's replace clears the container in C++ (not through _clear) and appends bodies.
-    result = _originalReplace(self, bodies, *args, **kw)
-    _freshScene(bodies)
-    return result
-
-
-_erase.__doc__ = _originalErase.__doc__
-_clear.__doc__ = _originalClear.__doc__
-_replace.__doc__ = _originalReplace.__doc__
-wrapper.BodyContainer.erase = _erase
-wrapper.BodyContainer.clear = _clear
-wrapper.BodyContainer.replace = _replace
+INTEGRATOR_COMMAND = 'import yade_dda.engines'
+"""How the command of a DDAIntegrator (yade_dda.engines) starts."""
+COLLIDER_COMMAND = 'import yade_dda.colliders as _ddac; _ddac._select('
+"""How the command of a collider engine (yade_dda.colliders) starts; files saved by YADE carry it."""
 
 
 # ------------------------------------------------------------------ initial overlaps
@@ -120,7 +62,7 @@ def markOverlapsChecked(scene):
 
 def _isIntegrator(engine):
     return (isinstance(engine, wrapper.PyRunner) and not engine.dead
-            and engine.command.startswith(_INTEGRATOR_COMMAND))
+            and engine.command.startswith(INTEGRATOR_COMMAND))
 
 
 def checkSingleIntegrator(engines):
@@ -129,6 +71,24 @@ def checkSingleIntegrator(engines):
         raise RuntimeError('O.engines holds %d DDA integrators (at positions %s); each would advance the blocks '
                            'once per iteration while O.time advances once. Keep one.'
                            % (len(positions), ', '.join(map(str, positions))))
+
+
+def checkColliderOrder(engines):
+    """A collider engine must run before DDAIntegrator, and only one may be in `engines`."""
+    colliders, integrator = [], None
+    for index, engine in enumerate(engines):
+        if isinstance(engine, wrapper.PyRunner) and not engine.dead:
+            if engine.command.startswith(COLLIDER_COMMAND):
+                colliders.append(index)
+            elif engine.command.startswith(INTEGRATOR_COMMAND) and integrator is None:
+                integrator = index
+    if len(colliders) > 1:
+        raise RuntimeError('O.engines holds %d DDA collider engines (at positions %s); keep one'
+                           % (len(colliders), ', '.join(map(str, colliders))))
+    if colliders and integrator is not None and integrator < colliders[0]:
+        raise RuntimeError('the DDA collider engine (O.engines[%d]) must come before DDAIntegrator '
+                           '(O.engines[%d]), as YADE colliders come before the interaction loop'
+                           % (colliders[0], integrator))
 
 
 def _handlesPolyhedra(engine):

@@ -123,8 +123,8 @@ def versions(script=None):
     """Versions worth keeping with a result: YADE, Python, the yade_dda module in use
     (path and a hash of its compiled core), and the git commit of the scene's source tree."""
     import yade
-    import yade_dda
     from . import _core
+    yade_dda = sys.modules[__package__]   # the package (loaded before any of its modules), not imported again
     out = {'yade': str(yade.config.version), 'python': sys.version.split()[0],
            'yade_dda': getattr(yade_dda, '__version__', None),
            'yade_dda_path': os.path.dirname(os.path.abspath(yade_dda.__file__))}

@@ -3,7 +3,8 @@
 YADE serializes its scene (bodies, engines, tags) but knows nothing of the DDA
 core, which holds the true state: deformed vertices, 12-unknown velocities,
 stresses, strains, contact history, the next time step. Importing yade_dda
-wraps ``Omega.save``, ``saveTmp``, ``load``, ``loadTmp`` and ``reload``:
+wraps ``Omega.save``, ``saveTmp``, ``load``, ``loadTmp`` and ``reload``
+(``yade_dda.installHooks``, with storeState and afterLoad from here):
 
 - before YADE saves, the core's state (a versioned, checksummed binary from
   ``_core.Scene.saveState``, zlib-compressed, base64) is put in
@@ -29,67 +30,15 @@ Example (resume from the newest checkpoint)::
     O.load(yade_dda.latestCheckpoint('checkpoints'))
     O.run()
 """
-import base64
-import binascii
-import json
 import os
 import re
-import struct
 import warnings
-import zlib
 
 from ._yade import O, wrapper
-from . import _core
 from . import scene as _scene
-from .engines import _Parameter, _initEngine, _finite
-
-STATE_TAG = 'yade_dda.state'
-# Text format of the tag: "<FORMAT> <base64 of zlib of (u64 info length, info JSON, core state)>".
-FORMAT = 'yade_dda-state/1'
-
-
-def _tag(name):
-    """O.tags[name], or '' when absent (YADE's tags have no get or del)."""
-    return O.tags[name] if name in O.tags.keys() else ''
-
-
-def encodeState(scene):
-    """The tag text holding a DDA scene's full state (see the module docstring)."""
-    info = dict(token=scene.token, iter=O.iter, steps=scene.core.steps(), bodies=scene.bodyOfBlock,
-                cover=list(scene.cover) if getattr(scene, 'cover', None) is not None else None,
-                checked=getattr(scene, 'overlapsChecked', 0))
-    infoBytes = json.dumps(info, separators=(',', ':')).encode('utf-8')
-    raw = struct.pack('<Q', len(infoBytes)) + infoBytes + scene.core.saveState()
-    return FORMAT + ' ' + base64.b64encode(zlib.compress(raw, 1)).decode('ascii')
-
-
-def decodeState(text):
-    """(info dict, core state bytes) from a tag text; ValueError naming what is wrong."""
-    where = "O.tags['%s']" % STATE_TAG
-    head, _, body = text.partition(' ')
-    if not head.startswith('yade_dda-state/'):
-        raise ValueError('%s does not hold a yade_dda state (it starts with %r)' % (where, text[:20]))
-    if head != FORMAT:
-        raise ValueError('%s has format %s; this yade_dda reads %s' % (where, head, FORMAT))
-    try:
-        compressed = base64.b64decode(body.encode('ascii'), validate=True)
-    except (binascii.Error, UnicodeEncodeError, ValueError) as error:
-        raise ValueError('%s is truncated or corrupt: not base64 (%s)' % (where, error)) from None
-    try:
-        raw = zlib.decompress(compressed)
-    except zlib.error as error:
-        raise ValueError('%s is truncated or corrupt: zlib says %s' % (where, error)) from None
-    if len(raw) < 8:
-        raise ValueError('%s is truncated: %d bytes' % (where, len(raw)))
-    (n,) = struct.unpack('<Q', raw[:8])
-    try:
-        info = json.loads(raw[8:8 + n].decode('utf-8'))
-        if not isinstance(info, dict) or not {'token', 'iter', 'steps', 'bodies'} <= set(info):
-            raise ValueError('keys missing')
-    except ValueError as error:
-        raise ValueError('%s is corrupt: its header cannot be read (%s)' % (where, error)) from None
-    return info, raw[8 + n:]
-
+from .params import Parameter, finite, initEngine
+from .scene import restoreState
+from .state import FORMAT, STATE_TAG, decodeState, encodeState, tag  # noqa: F401  (part of saveload's API)
 
 def storeState():
     """Puts the current DDA scene's state into O.tags (what the wrapped O.save
@@ -109,73 +58,11 @@ def storeState():
     return len(text)
 
 
-def restoreState():
-    """Rebuilds the DDA scene of the current YADE scene from
-    ``O.tags['yade_dda.state']`` (what the wrapped O.load does after YADE
-    reads). Returns the new DDA scene, or None when the YADE scene has no DDA
-    blocks. Raises ValueError naming the problem when the state is missing for
-    a DDA scene, stale, corrupt or of another version; then nothing changes."""
-    token = _tag(_scene.TAG)
-    text = _tag(STATE_TAG)
-    if not token:
-        return None
-    if not text:
-        raise ValueError(
-            'this YADE scene has DDA blocks but was saved without their DDA state (a file saved before yade_dda '
-            'could save it, or by a path that bypasses O.save); its DDA blocks cannot continue')
-    info, state = decodeState(text)
-    if info['token'] != token:
-        raise ValueError("O.tags['%s'] belongs to another DDA scene (token %s, this scene's is %s): stale state, "
-                         'not used' % (STATE_TAG, info['token'], token))
-    if info['iter'] != O.iter:
-        raise ValueError("O.tags['%s'] was written at iteration %d but the scene is at iteration %d: stale state "
-                         '(the scene was saved again without yade_dda?), not used' % (STATE_TAG, info['iter'], O.iter))
-    core = _core.Scene()
-    core.loadState(state)
-    bodies = info['bodies']
-    checked = info.get('checked', core.blockCount() if core.steps() > 0 else 0)
-    if (core.steps() != info['steps'] or core.blockCount() != len(bodies) or not isinstance(checked, int)
-            or isinstance(checked, bool) or not 0 <= checked <= len(bodies)):
-        raise ValueError("O.tags['%s'] is corrupt: its header and its core state disagree" % STATE_TAG)
-    for index, bodyId in enumerate(bodies):
-        body = O.bodies[bodyId] if 0 <= bodyId < len(O.bodies) else None
-        if body is None or not isinstance(body.shape, wrapper.Polyhedra):
-            raise ValueError('DDA block %d is shown by body %d, which is %s in the loaded scene: the saved DDA state '
-                             'does not match its bodies' % (index, bodyId, 'missing' if body is None
-                                                             else 'a %s' % type(body.shape).__name__))
-    scene = _scene.DDAScene(_scene.newToken())
-    scene.core = core
-    scene.bodyOfBlock = list(bodies)
-    scene.cover = tuple(info['cover']) if info.get('cover') is not None else None
-    # The blocks the saved scene had already checked for initial overlaps (guards.checkInitialOverlaps)
-    # stay checked: checked again, blocks pressed into each other by their contacts (an impact, a block
-    # sliding into a step) would be refused as overlapping and the run could not resume. Blocks that
-    # entered the core when the scene was saved (pending ones) are still checked at the next step, as
-    # they would have been without the save. States written before this was stored: all blocks of a
-    # scene that has stepped count as checked, none of one that has not.
-    scene.overlapsChecked = checked
-    _scene.register(scene)
-    O.tags[STATE_TAG] = ''
-    return scene
+# ---- around YADE's save and load (installed on Omega by yade_dda.hooks.installHooks)
 
-
-# ---- the wrapped Omega methods
-
-def _currentToken():
-    return _tag(_scene.TAG) or None
-
-
-def _wrapSave(original):
-    def save(self, *args, **kwargs):
-        stored = storeState()
-        try:
-            return original(self, *args, **kwargs)
-        finally:
-            if stored:
-                O.tags[STATE_TAG] = ''
-    save.__doc__ = original.__doc__ + '\n\n(yade_dda: also saves the DDA state, see yade_dda.saveload.)'
-    save._yadeDDA = original
-    return save
+def currentToken():
+    """The DDA token of the current YADE scene, or None."""
+    return tag(_scene.TAG) or None
 
 
 def afterLoad(before):
@@ -183,37 +70,15 @@ def afterLoad(before):
     scenes of the replaced and of the loaded token (both are stale now), then
     rebuild the loaded scene's DDA state from its tag. A scene with DDA blocks
     but no saved state loads with a warning; DDA calls then raise."""
-    loaded = _currentToken()
+    loaded = currentToken()
     for token in (before, loaded):
         if token:
             _scene.drop(token)
-    if loaded and not _tag(STATE_TAG):
+    if loaded and not tag(STATE_TAG):
         warnings.warn('the loaded scene has DDA blocks but no saved DDA state (saved before yade_dda could save it, '
                       'or by a path that bypasses O.save): its DDA blocks cannot continue', RuntimeWarning)
         return None
     return restoreState()
-
-
-def _wrapLoad(original):
-    def load(self, *args, **kwargs):
-        before = _currentToken()
-        result = original(self, *args, **kwargs)
-        afterLoad(before)
-        return result
-    load.__doc__ = original.__doc__ + '\n\n(yade_dda: also restores the DDA state, see yade_dda.saveload.)'
-    load._yadeDDA = original
-    return load
-
-
-def _install():
-    for name, wrap in (('save', _wrapSave), ('saveTmp', _wrapSave), ('load', _wrapLoad), ('loadTmp', _wrapLoad),
-                       ('reload', _wrapLoad)):
-        method = getattr(wrapper.Omega, name)
-        original = getattr(method, '_yadeDDA', method)   # never wrap twice (module reloads)
-        setattr(wrapper.Omega, name, wrap(original))
-
-
-_install()
 
 
 # ---- checkpoints
@@ -331,17 +196,17 @@ class Checkpoint(wrapper.PyRunner):
         O.engines = [DDAIntegrator(dt=1e-3), Checkpoint(period=10000, directory='checkpoints')]
     """
 
-    period = _Parameter(1000, lambda v: int(_finite('period', v, 1)), 'iterations between checkpoints')
-    directory = _Parameter('checkpoints', _checkString('directory'), 'directory of the checkpoint files')
-    name = _Parameter('checkpoint', _checkString('name'), 'file name stem')
-    keep = _Parameter(3, lambda v: int(_finite('keep', v, 1)), 'checkpoints kept')
-    format = _Parameter('.yade.gz', _checkFormat, 'file format by extension')
+    period = Parameter(1000, lambda v: int(finite('period', v, 1)), 'iterations between checkpoints')
+    directory = Parameter('checkpoints', _checkString('directory'), 'directory of the checkpoint files')
+    name = Parameter('checkpoint', _checkString('name'), 'file name stem')
+    keep = Parameter(3, lambda v: int(finite('keep', v, 1)), 'checkpoints kept')
+    format = Parameter('.yade.gz', _checkFormat, 'file format by extension')
 
     _names = ('period', 'directory', 'name', 'keep', 'format')
 
     def __init__(self, label='', **params):
         wrapper.PyRunner.__init__(self)
-        _initEngine(self, label, params)
+        initEngine(self, label, params)
         self.initRun = False
 
     def _updateCommand(self):

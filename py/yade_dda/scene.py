@@ -11,8 +11,9 @@ One core scene belongs to one YADE scene. It is found through a token stored in
 import time
 import uuid
 
-from ._yade import O
+from ._yade import O, wrapper
 from . import _core
+from . import state as _state
 
 TAG = 'yade_dda.scene'
 _scenes = {}
@@ -124,14 +125,13 @@ def current(create=True):
 
     A YADE scene loaded with DDA blocks whose core scene this process does not
     hold (loaded before yade_dda was imported) is restored from its saved DDA
-    state (yade_dda.saveload)."""
+    state (restoreState)."""
     token = O.tags[TAG] if TAG in O.tags.keys() else None
     if token and token in _scenes:
         return _scenes[token]
     if token:
-        from . import saveload
         try:
-            return saveload.restoreState()
+            return restoreState()
         except ValueError as error:
             raise RuntimeError('this YADE scene holds DDA blocks whose DDA state cannot be restored: %s' % error) from None
     if not create:
@@ -139,6 +139,75 @@ def current(create=True):
     scene = DDAScene(newToken())
     register(scene)
     return scene
+
+
+def restoreState():
+    """Rebuilds the DDA scene of the current YADE scene from
+    ``O.tags['yade_dda.state']`` (what the wrapped O.load does after YADE
+    reads). Returns the new DDA scene, or None when the YADE scene has no DDA
+    blocks. Raises ValueError naming the problem when the state is missing for
+    a DDA scene, stale, corrupt or of another version; then nothing changes."""
+    token = _state.tag(TAG)
+    text = _state.tag(_state.STATE_TAG)
+    if not token:
+        return None
+    if not text:
+        raise ValueError(
+            'this YADE scene has DDA blocks but was saved without their DDA state (a file saved before yade_dda '
+            'could save it, or by a path that bypasses O.save); its DDA blocks cannot continue')
+    info, state = _state.decodeState(text)
+    if info['token'] != token:
+        raise ValueError("O.tags['%s'] belongs to another DDA scene (token %s, this scene's is %s): stale state, "
+                         'not used' % (_state.STATE_TAG, info['token'], token))
+    if info['iter'] != O.iter:
+        raise ValueError("O.tags['%s'] was written at iteration %d but the scene is at iteration %d: stale state "
+                         '(the scene was saved again without yade_dda?), not used'
+                         % (_state.STATE_TAG, info['iter'], O.iter))
+    core = _core.Scene()
+    core.loadState(state)
+    bodies = info['bodies']
+    checked = info.get('checked', core.blockCount() if core.steps() > 0 else 0)
+    if (core.steps() != info['steps'] or core.blockCount() != len(bodies) or not isinstance(checked, int)
+            or isinstance(checked, bool) or not 0 <= checked <= len(bodies)):
+        raise ValueError("O.tags['%s'] is corrupt: its header and its core state disagree" % _state.STATE_TAG)
+    for index, bodyId in enumerate(bodies):
+        body = O.bodies[bodyId] if 0 <= bodyId < len(O.bodies) else None
+        if body is None or not isinstance(body.shape, wrapper.Polyhedra):
+            raise ValueError('DDA block %d is shown by body %d, which is %s in the loaded scene: the saved DDA state '
+                             'does not match its bodies' % (index, bodyId, 'missing' if body is None
+                                                             else 'a %s' % type(body.shape).__name__))
+    scene = DDAScene(newToken())
+    scene.core = core
+    scene.bodyOfBlock = list(bodies)
+    scene.cover = tuple(info['cover']) if info.get('cover') is not None else None
+    # The blocks the saved scene had already checked for initial overlaps (guards.checkInitialOverlaps)
+    # stay checked: checked again, blocks pressed into each other by their contacts (an impact, a block
+    # sliding into a step) would be refused as overlapping and the run could not resume. Blocks that
+    # entered the core when the scene was saved (pending ones) are still checked at the next step, as
+    # they would have been without the save. States written before this was stored: all blocks of a
+    # scene that has stepped count as checked, none of one that has not.
+    scene.overlapsChecked = checked
+    register(scene)
+    O.tags[_state.STATE_TAG] = ''
+    return scene
+
+
+def freshScene(bodies=()):
+    """Replaces the current DDA scene (its blocks are gone from O.bodies) by an
+    empty one that keeps the pending blocks among `bodies` and those made by
+    ddaBlock() but never appended (id < 0); what O.bodies.clear() and
+    replace() do after YADE's (yade_dda.installHooks).
+    (O.tags has no __delitem__, so the token is replaced rather than removed.)"""
+    old = current(create=False)
+    if old is None:
+        return
+    kept = {id(body) for body in bodies}
+    token = newToken()
+    fresh = DDAScene(token)
+    fresh.pending = [(body, spec) for body, spec in old.pending if body.id < 0 or id(body) in kept]
+    _scenes.pop(old.token, None)
+    _scenes[token] = fresh
+    O.tags[TAG] = token
 
 
 def _require():

@@ -7,7 +7,7 @@ import pytest
 import yade_dda
 from yade_dda import (O, ddaBlock, DDAIntegrator, DESSCollider, NBSCollider, AllPairsCollider, MSCCollider,
                       compareColliders)
-from yade_dda import engines as _engines
+from yade_dda import params as _settings
 from yade_dda import scene as _scene
 from yade import wrapper
 
@@ -104,7 +104,7 @@ def test_msc_engine_parameters_reach_the_core(scene):
     with segments=3 and the default critical length (3 x block size, about
     6.9 m here) each log gets three, and MSC offers fewer sub-unit pairs to
     the narrow phase than DESS for the same contacts."""
-    assert 'MSC' in _engines._COLLIDERS
+    assert 'MSC' in _settings.COLLIDERS
     logs = [(box((0, 1.05 * k, 0), (12, 1.05 * k + 1, 1)), k == 0) for k in range(6)]
     logs += [(box((1.05 * k, 0, 1.01), (1.05 * k + 1, 12, 2.01)), False) for k in range(6)]
     counts = {}
@@ -122,7 +122,7 @@ def test_msc_engine_parameters_reach_the_core(scene):
 
 
 def test_msc_parameters_are_checked_and_stored(scene, monkeypatch):
-    monkeypatch.setattr(_engines, '_COLLIDERS', _engines._COLLIDERS + ('MSC',) * ('MSC' not in _engines._COLLIDERS))
+    monkeypatch.setattr(_settings, 'COLLIDERS', _settings.COLLIDERS + ('MSC',) * ('MSC' not in _settings.COLLIDERS))
     engine = MSCCollider(label='msc')
     assert (engine.criticalLength, engine.segments) == (0.0, 3)
     engine.segments = 5
@@ -140,7 +140,7 @@ def test_compare_colliders_on_a_tiny_scene(scene, tmp_path):
     result = compareColliders(smallPile, steps=5, dt=1e-3, gravity=(0, 0, -G), out=str(out),
                               integrator=dict(maxDisplacement=0.005), verbose=False)
     names = [r['strategy'] for r in result['rows']]
-    ours = [n for n in ('MSC', 'DESS', 'NBS', 'AllPairs') if n in _engines._COLLIDERS]
+    ours = [n for n in ('MSC', 'DESS', 'NBS', 'AllPairs') if n in _settings.COLLIDERS]
     assert names == ours + ['InsertionSortCollider', 'SpatialQuickSortCollider']
     assert result['reference'] == ('MSC' if 'MSC' in ours else 'DESS')
     if 'MSC' not in ours:

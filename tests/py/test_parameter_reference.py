@@ -7,7 +7,7 @@ import os
 
 import pytest
 
-from yade_dda import _core, engines
+from yade_dda import _core, engines, params
 from yade_dda import DDAIntegrator
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -27,7 +27,7 @@ def test_parameter_reference_is_current():
 
 def test_every_core_setting_is_a_parameter_of_the_integrator():
     members = {name for name in dir(_core.IntegratorSettings) if not name.startswith('_')}
-    rows = {row['member']: row for row in engines._SETTINGS if row['member'] is not None}
+    rows = {row['member']: row for row in params.SETTINGS if row['member'] is not None}
     assert set(rows) == members
     core = _core.IntegratorSettings()
     for member, row in rows.items():
@@ -43,11 +43,11 @@ def test_a_parameter_reaches_the_core(name, value):
     engine = DDAIntegrator(**{name: value})
     text = engine.command[engine.command.index('(') + 1:-1]
     _, settings = engines._parse(ast.literal_eval(text))
-    member = next(row['member'] for row in engines._SETTINGS if row['name'] == name)
+    member = next(row['member'] for row in params.SETTINGS if row['name'] == name)
     assert getattr(settings, member) == value
 
 
 def test_the_docstring_lists_every_parameter():
-    for row in engines._SETTINGS:
+    for row in params.SETTINGS:
         assert '``%s``' % row['name'] in DDAIntegrator.__doc__
         assert getattr(DDAIntegrator, row['name']).__doc__ == row['doc']

@@ -77,7 +77,7 @@ def test_save_load_continue_is_bitwise(scene, reference, tmp_path, form):
         O.saveTmp('saveload')
     else:
         O.save(path)
-    assert saveload._tag(saveload.STATE_TAG) == '', 'the state tag is emptied after saving'
+    assert saveload.tag(saveload.STATE_TAG) == '', 'the state tag is emptied after saving'
     O.run(17, True)   # the live core scene runs past the saved state
     if form == 'saveTmp':
         O.loadTmp('saveload')
