@@ -493,3 +493,44 @@ def test_energy_account_is_exact_for_a_block_vibrating_at_finite_strain(scene, s
         worst = max(worst, abs(account(a) - account(a0)))
     assert max(volumes) - min(volumes) > 0.1 * 0.35, (min(volumes), max(volumes))  # finite strain indeed
     assert worst <= 1e-10 * biggest, (worst, biggest)
+
+
+def _prestressed_soft_block(cuts):
+    """A free 1 m cube with E = 1 kPa released from a tensile stress of 10 kPa in every
+    direction, no gravity, dt = 1 s and no displacement control: unchecked, its first
+    step's strain increment (about -4 per axis) would turn it inside out."""
+    mat = O.materials.append(wrapper.PolyhedraMat(density=1000, young=1e3, poisson=0.25))
+    b = O.bodies.append(yade_dda.ddaBlock(box((0, 0, 0), (1, 1, 1)), material=mat, stress=(1e4, 1e4, 1e4, 0, 0, 0)))
+    O.engines = [DDAIntegrator(gravity=(0, 0, 0), dt=1.0, maxDisplacement=1e9, maxStepCuts=cuts)]
+    return b
+
+
+def test_no_step_turns_a_block_inside_out(scene):
+    """Oracle: a step shrinks no deformable block below half its volume (World::solveStep
+    cuts dt until det(I + S) >= 0.5), so the volume stays positive however the block is
+    loaded, and the energy account stays exact while it shrinks (Hencky's law: the
+    stored energy grows without bound as the volume goes to zero)."""
+    b = _prestressed_soft_block(5)
+    volume = yade_dda.block(b).volume
+    cut = 0
+    O.step()
+    a0 = yade_dda.stats()['energy']
+    for _ in range(20):
+        O.step()
+        cut += yade_dda.stats()['stepCuts']
+        v = yade_dda.block(b).volume
+        assert 0 < v and v >= 0.5 * volume * (1 - 1e-12), (O.iter, v, volume)
+        volume = v
+        a = yade_dda.stats()['energy']
+        assert abs(account(a) - account(a0)) <= 1e-9 * max(a['strain'], a['kinetic']), (a, a0)
+    assert cut > 0
+
+
+def test_a_step_that_would_turn_a_block_inside_out_is_refused_by_name(scene):
+    """With no step cuts allowed, the same step is refused with an error naming the block
+    and the volume ratio, and the block is left as it was."""
+    b = _prestressed_soft_block(0)
+    before = yade_dda.block(b).vertices
+    with pytest.raises(RuntimeError, match=r'shrink block 0 to .* of its volume'):
+        O.step()
+    assert yade_dda.block(b).vertices == before

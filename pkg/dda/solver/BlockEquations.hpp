@@ -107,6 +107,12 @@ Vector12 solveBlock(const Block& block, const BlockSystem& system);
 // displacement is not finite.
 double largestVertexDisplacement(const Block& block, const Vector12& D);
 
+// The volume ratio det(I + S) a step's strain increment S gives a deformable
+// block (1 for a rigid block) [-]. The step maps the block by R (I + S).
+inline double stepJacobian(const Block& block, const Vector12& D) {
+	return block.rigid ? 1.0 : (Matrix3::Identity() + strainTensor(D.segment<6>(6))).determinant();
+}
+
 // The map of one block's points over a step: x -> c' + (I + S) R (x - c), an
 // exact rotation about the centroid c followed by the strain S, then the
 // translation (c' = c + t). Vertices, supports, loads and contact anchors all

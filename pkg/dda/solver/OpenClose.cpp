@@ -348,6 +348,15 @@ double OpenCloseIteration::largestDisplacement(const std::vector<Block>& blocks)
 	return largest;
 }
 
+std::pair<double, int> OpenCloseIteration::smallestJacobian(const std::vector<Block>& blocks) const {
+	std::pair<double, int> smallest{1.0, -1};
+	for (std::size_t k = 0; k < moving_.size(); ++k) {
+		const double jacobian = stepJacobian(blocks[moving_[k]], solutions_[k]);
+		if (!(jacobian >= smallest.first)) smallest = {jacobian, moving_[k]};
+	}
+	return smallest;
+}
+
 std::size_t OpenCloseIteration::memoryBytes() const {
 	return coupled_.memoryBytes() + capacityBytes(moving_) + capacityBytes(movingIndex_) +
 	       capacityBytes(solutions_) + capacityBytes(ownSystems_) + capacityBytes(ownSystemOf_) +

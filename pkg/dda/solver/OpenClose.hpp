@@ -41,6 +41,9 @@ public:
 	const Vector12& solutionOf(int block) const;
 	// Largest vertex displacement of the last attempt [m].
 	double largestDisplacement(const std::vector<Block>& blocks) const;
+	// The smallest stepJacobian over the moving blocks, and that block's index
+	// (-1 when no block moves).
+	std::pair<double, int> smallestJacobian(const std::vector<Block>& blocks) const;
 	// Whether the solver keeps work between solves (World::setSolverReuse).
 	void setSolverReuse(bool reuse) {
 		coupled_.setAnalysisReuse(reuse);
