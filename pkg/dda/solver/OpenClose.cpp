@@ -348,11 +348,11 @@ double OpenCloseIteration::largestDisplacement(const std::vector<Block>& blocks)
 	return largest;
 }
 
-std::pair<double, int> OpenCloseIteration::smallestJacobian(const std::vector<Block>& blocks) const {
-	std::pair<double, int> smallest{1.0, -1};
+StepShrink OpenCloseIteration::smallestJacobian(const std::vector<Block>& blocks) const {
+	StepShrink smallest;
 	for (std::size_t k = 0; k < moving_.size(); ++k) {
 		const double jacobian = stepJacobian(blocks[moving_[k]], solutions_[k]);
-		if (!(jacobian >= smallest.first)) smallest = {jacobian, moving_[k]};
+		if (!(jacobian >= smallest.jacobian)) smallest = {jacobian, moving_[k]};
 	}
 	return smallest;
 }

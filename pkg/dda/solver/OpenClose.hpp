@@ -12,6 +12,7 @@
 #include "ContactEquations.hpp"
 #include "CoupledSystem.hpp"
 #include "IntegratorSettings.hpp"
+#include "TimeStepControl.hpp"
 #include "dda/block/Block.hpp"
 #include "dda/contact/Contact.hpp"
 
@@ -41,9 +42,8 @@ public:
 	const Vector12& solutionOf(int block) const;
 	// Largest vertex displacement of the last attempt [m].
 	double largestDisplacement(const std::vector<Block>& blocks) const;
-	// The smallest stepJacobian over the moving blocks, and that block's index
-	// (-1 when no block moves).
-	std::pair<double, int> smallestJacobian(const std::vector<Block>& blocks) const;
+	// The smallest stepJacobian over the moving blocks, and that block.
+	StepShrink smallestJacobian(const std::vector<Block>& blocks) const;
 	// Whether the solver keeps work between solves (World::setSolverReuse).
 	void setSolverReuse(bool reuse) {
 		coupled_.setAnalysisReuse(reuse);

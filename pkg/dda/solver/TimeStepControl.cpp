@@ -3,15 +3,40 @@
 #include "dda/core/StateStream.hpp"
 
 #include <algorithm>
+#include <sstream>
+#include <stdexcept>
 
 namespace dda {
+
+namespace {
+// The smallest volume ratio det(I + S) one step may give a deformable block
+// [-]. The strain increment is a linearisation (ln(1 + e) against e is 20% off
+// at e = -0.3 per axis), and at det(I + S) = 0 the block would turn inside
+// out, its volume and mass matrix negative. Such a step is cut like a
+// too-large one (the strain increment shrinks with dt); if the cuts run out,
+// the step is refused with a named error and the scene stays as it was.
+constexpr double kMinStepJacobian = 0.5;
+}  // namespace
 
 double TimeStepControl::firstTry(const IntegratorSettings& settings) const {
 	return nextTimeStep_ > 0 ? std::min(nextTimeStep_, settings.maxTimeStep) : settings.maxTimeStep;
 }
 
-bool TimeStepControl::accept(int attempt, bool converged, double largest, const IntegratorSettings& settings,
-                             double& dt, StepStatistics& stats) {
+bool TimeStepControl::accept(int attempt, bool converged, double largest, const StepShrink& volume,
+                             const IntegratorSettings& settings, double& dt, StepStatistics& stats) {
+	if (converged && volume.jacobian < kMinStepJacobian) {
+		if (attempt == settings.maxStepCuts) {
+			std::ostringstream message;
+			message << "the DDA step would shrink block " << volume.block << " to " << volume.jacobian
+			        << " of its volume (at most to " << kMinStepJacobian << " in one step) even at dt = " << dt
+			        << " s: its material is too soft for its loads at this step (raise young, lower dt, or "
+			        << "check the loads)";
+			throw std::runtime_error(message.str());
+		}
+		dt *= 0.5;
+		++stats.stepCuts;
+		return false;
+	}
 	if (!converged) {
 		if (attempt == settings.maxStepCuts) {
 			++openCloseFailures_;

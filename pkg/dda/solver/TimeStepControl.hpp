@@ -11,6 +11,13 @@
 
 namespace dda {
 
+// The smallest volume ratio det(I + S) an attempt gives a deformable block [-],
+// and that block's index (-1 when no block moves).
+struct StepShrink {
+	double jacobian = 1.0;
+	int block = -1;
+};
+
 class StateWriter;
 class StateReader;
 
@@ -28,9 +35,11 @@ public:
 	double firstTry(const IntegratorSettings& settings) const;
 	// After attempt number `attempt` (0 first) at dt: whether it is accepted;
 	// else dt is cut for the next attempt. `largest` is its largest vertex
-	// displacement [m]; the cuts are counted in stats.
-	bool accept(int attempt, bool converged, double largest, const IntegratorSettings& settings, double& dt,
-	            StepStatistics& stats);
+	// displacement [m], `volume` its smallest volume ratio (accept's rule:
+	// below kMinStepJacobian the step is cut, and refused with a named error
+	// when the cuts run out); the cuts are counted in stats.
+	bool accept(int attempt, bool converged, double largest, const StepShrink& volume,
+	            const IntegratorSettings& settings, double& dt, StepStatistics& stats);
 	// The step was taken at dt: the next tries dt x timeStepGrowth.
 	void stepTaken(const IntegratorSettings& settings, double dt);
 	// The next step tries dt [s] first (settling's static steps).

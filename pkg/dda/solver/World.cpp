@@ -18,9 +18,6 @@
 namespace dda {
 
 namespace {
-// The smallest volume ratio det(I + S) one step may give a deformable block [-]
-// (World::solveStep).
-constexpr double kMinStepJacobian = 0.5;
 void requireFinite(const Vector3& v, const char* what) {
 	if (!v.allFinite()) {
 		std::ostringstream message;
@@ -186,28 +183,8 @@ double World::solveStep(const IntegratorSettings& settings, StepStatistics& stat
 			throw std::runtime_error(message.str());
 		}
 		stats.maxDisplacement = largest;
-		// No step may shrink a deformable block below kMinStepJacobian of its
-		// volume: the strain increment is a linearisation (ln(1 + e) against e
-		// is 20% off at e = -0.3 per axis) and at det(I + S) = 0 the block
-		// would turn inside out, its volume and mass matrix negative. Such a
-		// step is cut like a too-large one (the strain increment shrinks with
-		// dt); if the cuts run out, the step is refused with a named error
-		// and the scene stays as it was before it.
-		const auto [jacobian, worst] = openClose_.smallestJacobian(blocks_);
-		if (converged && jacobian < kMinStepJacobian) {
-			if (attempt == settings.maxStepCuts) {
-				std::ostringstream message;
-				message << "the DDA step would shrink block " << worst << " to " << jacobian
-				        << " of its volume (at most to " << kMinStepJacobian << " in one step) even at dt = " << dt
-				        << " s: its material is too soft for its loads at this step (raise young, lower dt, or "
-				        << "check the loads)";
-				throw std::runtime_error(message.str());
-			}
-			dt *= 0.5;
-			++stats.stepCuts;
-			continue;
-		}
-		if (timeStep_.accept(attempt, converged, largest, settings, dt, stats)) return dt;
+		if (timeStep_.accept(attempt, converged, largest, openClose_.smallestJacobian(blocks_), settings, dt, stats))
+			return dt;
 	}
 }
 
