@@ -117,7 +117,6 @@ def _worker(kind, spec, paperSteps):
 
 def scenes():
     """(name, kind, spec) of every scene fingerprinted."""
-    sys.path.insert(0, os.environ.get('YADE_DDA_BUILD', ''))
     table = os.path.join(REGRESSION, 'full.table')
     out = []
     for number, text in enumerate(open(table), start=1):
