@@ -12,7 +12,19 @@ import re
 
 import pytest
 
-REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+def _repository():
+    """The checkout's top folder: the nearest folder above this file with README.md and doc/
+    (so the file may move within tests/)."""
+    folder = os.path.dirname(os.path.abspath(__file__))
+    while not (os.path.isfile(os.path.join(folder, 'README.md')) and os.path.isdir(os.path.join(folder, 'doc'))):
+        parent = os.path.dirname(folder)
+        assert parent != folder, 'no README.md with a doc/ folder above ' + __file__
+        folder = parent
+    return folder
+
+
+REPO = _repository()
 README_MAX_LINES = 250
 
 PAGES = ['README.md'] + sorted(os.path.relpath(p, REPO) for p in glob.glob(os.path.join(REPO, 'doc', '*.md')))
