@@ -69,7 +69,7 @@ docs: build
 fingerprints: install
 	$(PYTHON) bench/fingerprints.py
 
-# Batch regressions (README, "Batch regressions"): yade-batch runs every row of a table in
+# Batch regressions (doc/user-guide.md, "Batch regressions"): yade-batch runs every row of a table in
 # examples/regression, each scene writes a record, check.py compares them with closed forms and
 # stored references and exits non-zero on any failure. Logs and records go to $(REGRESS_OUT)/<table>.
 REGRESS_OUT := $(BUILD)/regress
@@ -91,7 +91,7 @@ regress-run:
 	    --log "$$out/@.log" $(TABLE).table 2>&1) | tee $$out/yade-batch.log | grep --line-buffered -E '^#[0-9]+ \('; true
 	$(PYTHON) examples/regression/check.py examples/regression/$(TABLE).table $(abspath $(REGRESS_OUT))/$(TABLE) $(CHECK_ARGS)
 
-# Longer fuzzing of the geometry and contact kernels (README, "Bad input"): tests/fuzz's target built
+# Longer fuzzing of the geometry and contact kernels (doc/testing.md, "Fuzzing"): tests/fuzz's target built
 # with AddressSanitizer and UBSan in its own build tree, fed by the plain driver for FUZZ_SECONDS with
 # a seed from the clock (printed; findings are written to $(FUZZ_BUILD)/crashes). ctest runs the same
 # target for 20 s without sanitizers.
@@ -105,7 +105,7 @@ fuzz: deps
 	ASAN_OPTIONS=detect_leaks=0 $(FUZZ_BUILD)/fuzz_kernels_driver --seconds $(FUZZ_SECONDS) --seed $$(date +%s) \
 	    --crash-dir $(FUZZ_BUILD)/crashes tests/fuzz/corpus
 
-# Mutation checks of the hard-case suite (README, "Mutation checks"): each patch in tests/mutations
+# Mutation checks of the hard-case suite (doc/testing.md, "Mutation checks"): each patch in tests/mutations
 # removes one core protection; run.py builds the module for the unmutated tree, then for each patch,
 # in one incremental build tree ($(MUTATION_BUILD)), and runs the tests the patch names: the
 # unmutated tree must pass them and each mutation must make one fail. Long (a build per mutation),

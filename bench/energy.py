@@ -30,7 +30,7 @@ left its free fall); a run stops early once a block is --stop-speed (10) times
 its free-fall bound, or gainFull is above --stop-gain (0.5) (recorded as
 `stopped`); writes
 bench/out/energy_pile200.json. Not in `make bench`: it takes many minutes per
-E (see README, *Energy of a dropped pile*). --count/--side run
+E (see doc/benchmarks.md, "Energy of a dropped pile"). --count/--side run
 other piles of that builder (written to energy_pile<count>.json). --threads
 sets DDAIntegrator.threads (results do not depend on it; 1 is fair to other
 users of the machine).

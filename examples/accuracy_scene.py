@@ -1,5 +1,5 @@
 # -*- coding: utf-8 -*-
-"""A scene for the accuracy sweep (README, "What accuracy costs"): your own scene has the same shape.
+"""A scene for the accuracy sweep (doc/benchmarks.md, "Your own scene"): your own scene has the same shape.
 
 A 1 m cube of rock slides across a fixed floor with v0 = 2 m/s and stops by
 Coulomb friction (phi = 30 deg). Closed form: the deceleration is g tan(phi),
