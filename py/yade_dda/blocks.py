@@ -1,5 +1,6 @@
 """Making DDA blocks: YADE bodies with a Polyhedra shape, backed by the DDA core."""
 import math
+import random
 
 from ._yade import O, utils, wrapper
 from . import _core
@@ -25,6 +26,15 @@ class BlockSpec:
             return self.points
         x, y, z = self.shift
         return [(p[0] + x, p[1] + y, p[2] + z) for p in self.points]
+
+
+_PALETTE = random.Random(20140101)
+"""Colours of blocks made without one: a generator of our own, so Python's ``random`` (which YADE's
+``randomColor`` draws from) is left alone and a script's colours are the same on every run."""
+
+
+def _nextColor():
+    return tuple(_PALETTE.random() for _ in range(3))
 
 
 def _finiteNonNegative(value, what, unit):
@@ -217,8 +227,7 @@ def ddaBlock(vertices, material=None, fixed=False, color=None, velocity=(0, 0, 0
                              '(make the block deformable, or drop the stress)' % (stress,))
     if not isinstance(mask, int) or isinstance(mask, bool):
         raise TypeError('mask must be an int, got %r' % (mask,))
-    if color is not None:
-        color = vector(color, 'color')
+    color = vector(color, 'color') if color is not None else _nextColor()
 
     # YADE's shape is made from the corners shifted near the origin (see _nearOrigin); the body is then put
     # back: pos = shift + YADE's centroid (rounded; SceneLink's vertex match allows for it). The spec keeps

@@ -14,7 +14,9 @@ from ._yade import O, wrapper
 from . import _core
 from . import guards as _guards
 from . import scene as _scene
-from .params import Parameter, RULES, SETTINGS, initEngine, parameterLine
+from .hooks import USER_DT_TAG, writeDt
+from .state import tag
+from .params import Engine, Parameter, RULES, SETTINGS, initEngine, parameterLine
 
 
 _INTEGRATOR_DOC = """Shi's implicit DDA time integration of all DDA blocks, with their contacts
@@ -50,7 +52,7 @@ _INTEGRATOR_DOC = """Shi's implicit DDA time integration of all DDA blocks, with
                                for row in SETTINGS))
 
 
-class DDAIntegrator(wrapper.PyRunner):
+class DDAIntegrator(Engine, wrapper.PyRunner):
     __doc__ = _INTEGRATOR_DOC
     _names = tuple(row['name'] for row in SETTINGS)
 
@@ -63,11 +65,22 @@ class DDAIntegrator(wrapper.PyRunner):
         return {name: cls.__dict__[name].default for name in cls._names}
 
     def _updateCommand(self):
-        # Parameters that differ from the defaults travel as one string literal,
-        # parsed once per distinct string (see _parse) and cached.
-        defaults = self._defaults()
-        changed = {k: v for k, v in self._params.items() if v != defaults[k]}
-        self.command = 'import yade_dda.engines as _dda; _dda.integratorStep(%r)' % (repr(changed),)
+        self._setYade('command', _command(self._params))
+
+
+_COMMAND = 'import yade_dda.engines as _dda; _dda.integratorStep(%r)'
+
+
+def _text(params):
+    """The parameters that differ from the defaults, as the text integratorStep receives: one string
+    literal in the command, parsed once per distinct string (see _parse) and cached."""
+    defaults = DDAIntegrator._defaults()
+    return repr({k: v for k, v in params.items() if v != defaults[k]})
+
+
+def _command(params):
+    """DDAIntegrator's command for its parameters."""
+    return _COMMAND % (_text(params),)
 
 
 for _row in SETTINGS:
@@ -146,9 +159,27 @@ def _checkEngines(scene, engines):
                         % (bodyId, body.groupMask, engine.mask))
 
 
+def _takeUserDt(text):
+    """The parameter text with ``dt`` set to the time step the script assigned to O.dt
+    (hooks.USER_DT_TAG), written into the engine that runs `text`; the tag is cleared."""
+    value = float(tag(USER_DT_TAG))
+    O.tags[USER_DT_TAG] = ''
+    params = dict(_parse(text)[0], dt=value)
+    for engine in O.engines:
+        if isinstance(engine, wrapper.PyRunner) and engine.command == _COMMAND % (text,):
+            if isinstance(engine, DDAIntegrator):
+                engine.dt = value
+            else:   # an engine back from O.load is a plain PyRunner with our command
+                engine.command = _command(params)
+            break
+    return _text(params)
+
+
 def integratorStep(text):
     """One DDA step; called by DDAIntegrator's command every iteration with its parameters."""
     start = time.perf_counter()
+    if tag(USER_DT_TAG):
+        text = _takeUserDt(text)
     params, settings = _parse(text)
     scene = _scene.current()
     before = len(scene.bodyOfBlock)
@@ -171,7 +202,7 @@ def integratorStep(text):
     if collider == 'MSC' and getattr(scene, 'cover', None) != cover:
         scene.core.setCover(float(cover[0]), int(cover[1]))
         scene.cover = cover
-    O.dt = scene.core.step(settings)
+    writeDt(scene.core.step(settings))
     if _syncNeeded(params, engines):
         scene.sync()
     scene.stepTimeTotal += time.perf_counter() - start
