@@ -206,3 +206,48 @@ def integratorStep(text):
     if _syncNeeded(params, engines):
         scene.sync()
     scene.stepTimeTotal += time.perf_counter() - start
+    period = params['progressPeriod']
+    if period != 0:
+        _progress(scene, period if period > 0 else AUTO_PROGRESS_PERIOD if sys.stdout.isatty() else 0)
+
+
+AUTO_PROGRESS_PERIOD = 30.0
+"""Wall seconds between progress lines when ``progressPeriod`` < 0 and stdout is a terminal."""
+
+
+def _progress(scene, period):
+    """Prints one progress line every `period` wall seconds of a run (DDAIntegrator.progressPeriod):
+    steps/s and simulated seconds per wall second since the last line, O.time, dt, closed contacts, and
+    an ETA from O.stopAtIter (O.run(n)) or else O.stopAtTime."""
+    if period <= 0:
+        return
+    now = time.perf_counter()
+    last = getattr(scene, 'progressMark', None)
+    if last is None or O.iter < last[1]:
+        scene.progressMark = (now, O.iter, O.time)
+        return
+    wall, iteration, simulated = last
+    if now - wall < period:
+        return
+    scene.progressMark = (now, O.iter, O.time)
+    stepsPerSecond = (O.iter - iteration) / (now - wall)
+    timeRate = (O.time - simulated) / (now - wall)
+    eta = ''
+    if O.stopAtIter > O.iter and stepsPerSecond > 0:
+        eta = ', ETA %s (O.stopAtIter %d)' % (_duration((O.stopAtIter - O.iter) / stepsPerSecond), O.stopAtIter)
+    elif O.stopAtTime > O.time and timeRate > 0:
+        eta = ', ETA %s (O.stopAtTime %g s)' % (_duration((O.stopAtTime - O.time) / timeRate), O.stopAtTime)
+    counts = scene.core.lastStep()
+    print('yade_dda: iter %d, %.1f steps/s, O.time %.6g s (%.3g s per wall s), dt %.3g s, %d closed contacts in '
+          '%d pairs%s' % (O.iter, stepsPerSecond, O.time, timeRate, O.dt, counts['closedContacts'],
+                          counts['contactPairs'], eta), flush=True)
+
+
+def _duration(seconds):
+    """'2 h 05 min', '3 min 20 s' or '45 s'."""
+    seconds = int(round(seconds))
+    if seconds >= 3600:
+        return '%d h %02d min' % (seconds // 3600, seconds % 3600 // 60)
+    if seconds >= 60:
+        return '%d min %02d s' % (seconds // 60, seconds % 60)
+    return '%d s' % seconds

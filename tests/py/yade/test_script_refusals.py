@@ -228,3 +228,29 @@ def test_o_dt_reaches_an_engine_back_from_a_file(scene, tmp_path):
     O.run(5, True)
     assert "'dt': 0.0002" in O.engines[0].command
     assert O.dt <= 2e-4
+
+
+# ---- progress of a long run
+
+def _progressLines(capsys, steps, **params):
+    O.bodies.append(yade_dda.ddaBlock(box((0, 0, 0), (1, 1, 1)), material=material(O)))
+    O.engines = [yade_dda.DDAIntegrator(dt=1e-3, gravity=(0, 0, -9.81), **params)]
+    capsys.readouterr()
+    O.run(steps, True)
+    return [line for line in capsys.readouterr().out.splitlines() if line.startswith('yade_dda: iter')]
+
+
+def test_progress_lines_report_rate_time_and_eta(scene, capsys):
+    lines = _progressLines(capsys, 40, progressPeriod=1e-9)
+    assert len(lines) >= 30, lines
+    iterations = [int(line.split()[2].rstrip(',')) for line in lines]
+    assert iterations == sorted(iterations) and iterations[-1] <= 40
+    assert all('steps/s' in line and 'dt 0.001 s' in line and 'closed contacts' in line for line in lines)
+    assert all('(O.stopAtIter 40)' in line for line in lines[:-1]), lines
+
+
+def test_progress_is_off_in_batch_runs_and_when_asked(scene, capsys):
+    """Under pytest stdout is no terminal, as in yade-batch: the default (-1) prints nothing; 0 is off."""
+    assert _progressLines(capsys, 20) == []
+    O.reset()
+    assert _progressLines(capsys, 20, progressPeriod=0) == []
