@@ -36,7 +36,7 @@ test: install
 	$(PYTHON) -m pytest -q tests/py
 
 # Everything `test` runs plus the cases marked slow (pytest.ini deselects them by default), and the
-# narrow-phase oracle (tests/cpp/test_narrow_phase_oracle.cpp) on 2,000,000 random pairs instead of
+# narrow-phase oracle (tests/cpp/contact/test_narrow_phase_oracle.cpp) on 2,000,000 random pairs instead of
 # 100,000 (about 6 minutes; DDA_ORACLE_SEED picks another sample).
 ORACLE_PAIRS ?= 2000000
 test-hard: install
@@ -60,7 +60,7 @@ bench-pile200: install
 
 # The parameter reference doc/parameters.md, generated from the settings' one declaration
 # (pkg/dda/solver/Settings.def) through the built module by tools/gen_docs.py;
-# tests/py/test_parameter_reference.py fails when it is stale.
+# tests/py/package/test_parameter_reference.py fails when it is stale.
 docs: build
 	YADE_DDA_BUILD=$(abspath $(BUILD))/py $(PYTHON) tools/gen_docs.py
 

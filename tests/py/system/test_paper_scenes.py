@@ -15,7 +15,7 @@ import pytest
 from yade_dda import O, DDAIntegrator, ddaBlock, stats, block, contacts
 from yade import wrapper
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'examples', 'paper'))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', '..', 'examples', 'paper'))
 import paper_scenes as scenes  # noqa: E402
 
 G = 9.81

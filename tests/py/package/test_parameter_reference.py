@@ -10,7 +10,7 @@ import pytest
 from yade_dda import _core, engines, params
 from yade_dda import DDAIntegrator
 
-REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
 
 
 def _genDocs():

@@ -21,10 +21,13 @@ H = float.fromhex   # exact coordinates of fuzz findings
 
 
 def snapshot():
-    """What must not change when bad input is refused."""
+    """What must not change when bad input is refused: the bodies, O.iter, O.time, the DDA
+    step count and the blocks made by ddaBlock but not appended yet (a refused block leaves
+    none waiting)."""
     dda = yade_dda.scene.current(create=False)
     return (len(O.bodies), [None if b is None else (b.id, tuple(b.state.pos), tuple(b.state.vel)) for b in O.bodies],
-            O.iter, O.time, None if dda is None else dda.core.steps())
+            O.iter, O.time,
+            None if dda is None else (dda.core.steps(), sum(1 for body, _ in dda.pending if body.id < 0)))
 
 
 def coreSnapshot():
@@ -60,11 +63,12 @@ def refused(error, match, action):
     (UNIT + [(1, 1, 1)], r'points 7 and 8 coincide'),
     (UNIT[:7] + [(float('nan'), 1, 1)], r'point 7 has a non-finite coordinate'),
     (UNIT[:7] + [(1, float('-inf'), 1)], r'point 7 has a non-finite coordinate'),
+    (UNIT[:7] + [(1, float('inf'), 1)], r'point 7 has a non-finite coordinate'),
     (UNIT + [(0.5, 0.5, 0.5)], r'point 8 .* strictly inside the hull .* not convex'),
     (UNIT + [(0.5, 0.5, 1)], r'point 8 .* on the hull surface but is not a corner: it is inside a face'),
     (UNIT + [(0.5, 0, 0)], r'point 8 .* not a corner: it is inside an edge'),
     (box((0, 0, 0), (1, 1, 1e-10)), r'too flat'),
-], ids=['3 points', 'coplanar', 'collinear', 'duplicate', 'NaN', 'inf', 'non-convex', 'point in a face',
+], ids=['3 points', 'coplanar', 'collinear', 'duplicate', 'NaN', '-inf', '+inf', 'non-convex', 'point in a face',
         'point in an edge', 'zero volume'])
 def test_bad_block_geometry(scene, points, match):
     refused(ValueError, match, lambda: ddaBlock(points))
@@ -197,11 +201,17 @@ def test_bad_integrator_parameters(scene, kw, error, match):
     refused(error, match, lambda: DDAIntegrator(**kw))
 
 
-def test_bad_parameter_assigned_to_a_running_integrator_keeps_the_old_value(scene):
+def test_parameter_assigned_to_a_running_integrator_is_checked_and_kept(scene):
+    """A bad value (inf, 0) is refused and the old one kept; a good one reaches the engine in
+    O.engines (the same instance) and its command."""
     running()
     dda = O.engines[0]
     refused(ValueError, r'dt must be finite', lambda: setattr(dda, 'dt', float('inf')))
+    refused(ValueError, r'dt must be finite and in \(0, inf\), got 0', lambda: setattr(dda, 'dt', 0))
     assert dda.dt == 1e-3 and "'dt'" not in dda.command
+    dda.dt = 2e-3
+    assert O.engines[0].dt == 2e-3
+    assert "'dt': 0.002" in O.engines[0].command
 
 
 @pytest.mark.parametrize('kw, error, match', [
@@ -231,9 +241,12 @@ def test_two_collider_engines_are_refused(scene):
 
 
 def test_collider_engine_after_the_integrator_is_refused(scene):
+    """Refused by O.step and by O.run alike, the scene unchanged."""
     running()
     O.engines = list(O.engines) + [DESSCollider()]
     refused(RuntimeError, r'the DDA collider engine \(O.engines\[1\]\) must come before DDAIntegrator', O.step)
+    refused(RuntimeError, r'the DDA collider engine \(O.engines\[1\]\) must come before DDAIntegrator',
+            lambda: O.run(1, True))
 
 
 def test_time_step_whose_solution_is_not_finite_stops_with_an_error(scene):

@@ -697,7 +697,7 @@ def test_frictional_start_up_error_is_the_penalty_springs(scene):
     rest (startFromRest, the default) removes it: settled with friction locked, the
     shear springs already carry the block's weight, and the error at dt = 1e-5 s is
     a tenth of the preloaded one at most."""
-    sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..', '..', 'bench'))
+    sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..', '..', '..', 'bench'))
     from friction_startup import velocityError, DURATION, G, SLOPE, FRICTION
     at = G * (math.sin(SLOPE) - math.tan(FRICTION) * math.cos(SLOPE)) * DURATION
     coarse, coarseStiffer = velocityError(1e-3, 40.0), velocityError(1e-3, 400.0)   # as placed, preloaded by hand

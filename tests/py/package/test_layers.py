@@ -15,7 +15,7 @@ above the binding and includes no C++ header.
 import os
 import re
 
-REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
 
 LAYERS = [
     (0, 'core', ['dda/core']),          # basic types, errors, serialization, heap accounting
@@ -60,7 +60,7 @@ def violations(pkg):
             name = os.path.relpath(path, pkg)
             own = layer_of(path, pkg)
             if own is None:
-                found.append('%s: in no layer (add its folder to LAYERS in tests/py/test_layers.py)' % name)
+                found.append('%s: in no layer (add its folder to LAYERS in tests/py/package/test_layers.py)' % name)
                 continue
             text = open(path, encoding='utf-8').read()
             for match in INCLUDE.finditer(text):

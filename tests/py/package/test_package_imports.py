@@ -6,7 +6,7 @@ import os
 
 import yade_dda
 
-PACKAGE = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'py', 'yade_dda')
+PACKAGE = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', '..', 'py', 'yade_dda')
 COMPILED = ('_core',)   # the C++ module, built from pkg/dda: imports no Python sibling
 TOOLS = ('compare', 'accuracy', 'regression', 'compareColliders', 'sweep')
 

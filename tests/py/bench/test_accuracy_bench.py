@@ -31,7 +31,7 @@ import yade_dda
 from yade_dda import O, ddaBlock, DDAIntegrator, block
 from yade import wrapper
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
 BENCH = os.path.join(ROOT, 'bench', 'accuracy.py')
 
 

@@ -61,10 +61,13 @@ def test_recorder_sees_core_state_when_it_runs(scene):
     del builtins._ddaRecord
 
 
-def test_run_end_and_single_step_leave_bodies_current(scene):
+def test_run_syncs_once_at_its_end_and_a_single_step_leaves_bodies_current(scene):
+    """O.run syncs the bodies once, when it ends (nothing read them before: an effect on
+    demand), and leaves them current; so does a single O.step."""
     body = O.bodies.append(ddaBlock(box((0, 0, 0), (1, 1, 1)), velocity=(1, 2, 3)))
     O.engines = [DDAIntegrator(dt=1e-3, maxDisplacement=1, label='dda')]
     O.run(37, True)
+    assert yade_dda.stats()['syncs'] == 1
     assert O.bodies[body].state.pos == yade_dda.block(body).centroid
     O.step()
     assert O.bodies[body].state.pos == yade_dda.block(body).centroid

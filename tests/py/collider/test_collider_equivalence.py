@@ -16,7 +16,7 @@ import pytest
 from yade_dda import O, DDAIntegrator, ddaBlock, stats, contacts
 from yade import wrapper
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'examples', 'paper'))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', '..', 'examples', 'paper'))
 import paper_scenes as scenes  # noqa: E402
 
 STRATEGIES = ('AllPairs', 'MSC', 'DESS', 'NBS')
@@ -79,7 +79,7 @@ def test_slender_deposit_every_strategy_finds_the_all_pairs_contacts(scene):
     at every step, MSC proposes at most twice the pairs within d0 (issue 4),
     and no sub-contact starts deeper than an edge crossing may (d0): crossed
     logs once got edge crossings 1 m "deep" from a face axis of theirs."""
-    sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'bench'))
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', '..', 'bench'))
     import colliders as bench  # noqa: E402
     verts, _ = bench.slenderScene(150, seed=2)
     settings = bench.SLENDER

@@ -1,11 +1,9 @@
-"""Blocks made from YADE scripts: exact mass properties, bodies, and bad input."""
+"""Blocks made from YADE scripts: exact mass properties (volume, centroid, second moments) and the
+YADE body's mass and inertia. Bad block input is tested in yade/test_bad_input.py."""
 import math
 
-import pytest
-
 import yade_dda
-from yade_dda import O, ddaBlock, DDAIntegrator
-from yade import wrapper
+from yade_dda import O, ddaBlock
 
 from helpers import box, material, rotate
 
@@ -88,72 +86,3 @@ def test_irregular_polyhedron_properties_are_invariant_under_rigid_motion(scene)
             p, q, r = (verts[f[0]] - c), (verts[f[k]] - c), (verts[f[k + 1]] - c)
             V += p.dot(q.cross(r)) / 6
     assert rel(V, a.volume) < 1e-12
-
-
-@pytest.mark.parametrize('points, message', [
-    (box((0, 0, 0), (1, 1, 1))[:3], 'at least 4'),
-    ([(0, 0, 0), (1, 0, 0), (0, 1, 0), (1, 1, 0), (0.5, 0.2, 0)], 'coplanar'),
-    (box((0, 0, 0), (1, 1, 1)) + [(1, 1, 1)], 'coincide'),
-    (box((0, 0, 0), (1, 1, 1))[:7] + [(float('nan'), 1, 1)], 'non-finite'),
-    (box((0, 0, 0), (1, 1, 1))[:7] + [(1, float('inf'), 1)], 'non-finite'),
-    (box((0, 0, 0), (1, 1, 1)) + [(0.5, 0.5, 0.5)], 'inside'),
-])
-def test_bad_geometry_raises_and_leaves_scene_unchanged(scene, points, message):
-    before = len(O.bodies)
-    with pytest.raises(ValueError, match=message):
-        ddaBlock(points)
-    assert len(O.bodies) == before
-    dda = yade_dda.scene.current(create=False)
-    assert dda is None or not dda.pending
-
-
-@pytest.mark.parametrize('kw, message', [
-    (dict(density=0), 'density'),
-    (dict(density=-2600), 'density'),
-    (dict(poisson=0.5), "Poisson"),
-    (dict(poisson=-1.0), "Poisson"),
-    (dict(young=0), "Young"),
-])
-def test_bad_material_raises_and_leaves_scene_unchanged(scene, kw, message):
-    params = dict(young=4e6, poisson=0.25, density=2600)
-    params.update(kw)
-    mat = O.materials.append(wrapper.PolyhedraMat(**params))
-    with pytest.raises(ValueError, match=message):
-        ddaBlock(box((0, 0, 0), (1, 1, 1)), material=mat)
-    assert len(O.bodies) == 0
-
-
-def test_unknown_material_and_bad_vectors_raise(scene):
-    with pytest.raises(IndexError):
-        ddaBlock(box((0, 0, 0), (1, 1, 1)), material=5)
-    with pytest.raises(KeyError, match='granite'):
-        ddaBlock(box((0, 0, 0), (1, 1, 1)), material='granite')
-    with pytest.raises(ValueError, match='velocity'):
-        ddaBlock(box((0, 0, 0), (1, 1, 1)), velocity=(float('nan'), 0, 0))
-    with pytest.raises(ValueError, match='fixed block'):
-        ddaBlock(box((0, 0, 0), (1, 1, 1)), fixed=True, velocity=(1, 0, 0))
-    with pytest.raises(ValueError, match='3 coordinates'):
-        ddaBlock([(0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1)])
-    assert len(O.bodies) == 0
-
-
-@pytest.mark.parametrize('kw, message', [
-    (dict(dt=0), 'dt'), (dict(dt=-1e-3), 'dt'), (dict(dt=float('nan')), 'dt'),
-    (dict(velocityRatio=1.5), 'velocityRatio'), (dict(gravity=(0, 0)), 'gravity'),
-    (dict(maxDisplacementRatio=0), 'maxDisplacementRatio'), (dict(bogus=1), 'bogus'),
-])
-def test_bad_engine_parameters_raise(scene, kw, message):
-    with pytest.raises((ValueError, TypeError), match=message):
-        DDAIntegrator(**kw)
-
-
-def test_engine_parameter_assignment_is_validated_and_kept(scene):
-    dda = DDAIntegrator(dt=1e-3, label='dda')
-    O.engines = [dda]
-    with pytest.raises(ValueError, match='dt'):
-        dda.dt = 0
-    assert dda.dt == 1e-3
-    dda.dt = 2e-3
-    # the instance in O.engines is the same subclass instance, and its command carries the value
-    assert O.engines[0].dt == 2e-3
-    assert "'dt': 0.002" in O.engines[0].command

@@ -75,13 +75,6 @@ def test_without_engine_the_integrator_parameter_applies_again(scene):
     assert _scene.current().core.collider() == 'AllPairs'
 
 
-def test_collider_engine_after_the_integrator_is_refused(scene):
-    build(smallPile(), [integrator(), DESSCollider()])
-    with pytest.raises(RuntimeError) as error:
-        O.run(1, True)
-    assert 'must come before DDAIntegrator' in str(error.value)
-
-
 def test_same_trajectories_with_every_strategy(scene):
     """All strategies find the same contacts, so the blocks move identically (bit for bit)."""
     results = {}

@@ -1,7 +1,6 @@
-"""Blocks moving alone inside YADE, checked against closed forms."""
+"""Blocks moving alone inside YADE, checked against closed forms. Free fall under every member of
+the time scheme is in solver/test_time_scheme.py."""
 import math
-
-import pytest
 
 import yade_dda
 from yade_dda import O, ddaBlock, DDAIntegrator
@@ -18,21 +17,6 @@ def run_until(t_end, dt):
         dda.dt = min(dt, t_end - O.time)
         O.step()
     dda.dt = dt
-
-
-@pytest.mark.parametrize('v0', [(0.0, 0.0, 0.0), (3.0, -1.0, 7.5)], ids=['from-rest', 'thrown'])
-def test_free_fall_is_exact(scene, v0):
-    body = O.bodies.append(ddaBlock(box((0, 0, 50), (1, 2, 53)), material=material(O), velocity=v0))
-    O.engines = [DDAIntegrator(dt=1e-3, gravity=(0, 0, -G), maxDisplacement=1.0, label='dda')]
-    O.run(1000, True)
-    t = O.time
-    assert abs(t - 1.0) < 1e-12
-    pos, vel = O.bodies[body].state.pos, O.bodies[body].state.vel
-    expected = (0.5 + v0[0] * t, 1.0 + v0[1] * t, 51.5 + v0[2] * t - G * t * t / 2)
-    for i in range(3):
-        assert abs(pos[i] - expected[i]) <= 1e-9 * max(abs(expected[i]), 1.0)
-    assert abs(vel[2] - (v0[2] - G * t)) <= 1e-9 * G
-    assert max(abs(x) for x in yade_dda.block(body).strain) < 1e-12
 
 
 def test_time_follows_adaptive_step_and_free_fall_stays_exact(scene):

@@ -1,9 +1,10 @@
 """Effects on demand, seen from a YADE script: ``stats()['effects']`` says what
 the last step simulated; the counters show unused work is not done
 (no friction terms without friction, no body force without gravity, no
-broad-phase search of a resting pile, one sync per ``O.run``), and each test
-checks the results did not change (against the same scene with the work
-done, or a closed form).
+broad-phase search of a resting pile), and each test checks the results did
+not change (against the same scene with the work done, or a closed form). One
+sync per ``O.run`` is tested with the YADE link, in
+yade/test_yade_integration.py (test_run_syncs_once_at_its_end_and_a_single_step_leaves_bodies_current).
 """
 import math
 
@@ -94,11 +95,3 @@ def test_resting_pile_reuses_pairs_with_the_same_contacts(scene):
     assert effects['restingReuse'] is True and effects['fixedBlocks'] == 1
     for step, (a, b) in enumerate(zip(cached, searched)):
         assert a == b, 'contacts differ at step %d' % step
-
-
-def test_run_syncs_once_and_leaves_bodies_current(scene):
-    body = O.bodies.append(ddaBlock(box((0, 0, 0), (1, 1, 1)), velocity=(1, 0, 0)))
-    O.engines = [DDAIntegrator(dt=1e-3, maxDisplacement=1, label='dda')]
-    O.run(100, True)
-    assert stats()['syncs'] == 1          # nothing read the bodies before the run ended
-    assert O.bodies[body].state.pos == yade_dda.block(body).centroid

@@ -220,25 +220,6 @@ def test_block_that_must_hold_does_not_creep(scene, case):
     assert S.norm(S.sub(c2, c1)) < 5e-6, (c1, c2)
 
 
-@pytest.mark.parametrize('dt', [1e-2, 1e-3])
-def test_pushed_block_slides_as_coulomb_says(scene, dt):
-    """Pushed at 1.05 x its friction limit, the cube accelerates at 0.05 mu g: its
-    displacement between 0.1 s and 0.5 s is the closed form's within 2% (and within
-    1e-9 m sideways, the set-up being symmetric in y). dt = 1e-4 s, where the
-    contacts' start-up still adds 7%, is for the start-from-rest work (README)."""
-    cube = cube_on_slope(1.05, pushed=True)
-    O.engines[0].dt = dt
-    O.run(int(round(0.1 / dt)), True)
-    t1, c1 = O.time, yade_dda.block(cube).centroid
-    O.run(int(round(0.4 / dt)), True)
-    t2, c2 = O.time, yade_dda.block(cube).centroid
-    assert abs(t2 - 0.5) < 1e-9   # no step was cut
-    acc = 0.05 * math.tan(math.radians(30)) * G
-    expected = 0.5 * acc * (t2 ** 2 - t1 ** 2)
-    assert abs((c2[0] - c1[0]) - expected) < 0.02 * expected, (c2[0] - c1[0], expected)
-    assert abs(c2[1]) < 1e-9
-
-
 def wedge_scene(geo, fs, ratio=1.0, dt=2e-3):
     """Two fixed slabs and the free wedge of `geo` (scenes.wedge_geometry's dict), each
     plane's friction set for the factor of safety fs with tan(phi_B)/tan(phi_A) = ratio

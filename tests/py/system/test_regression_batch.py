@@ -29,7 +29,7 @@ import yade_dda
 from yade_dda import O, regression
 from yade import utils
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
 REGRESSION = os.path.join(ROOT, 'examples', 'regression')
 CHECK = os.path.join(REGRESSION, 'check.py')
 QUICK = os.path.join(REGRESSION, 'quick.table')
