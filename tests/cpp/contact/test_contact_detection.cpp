@@ -1093,7 +1093,7 @@ TEST(ContactDetection, GhostPairsOfTheDepositHaveNoNegativeGap) {
 
 // Three pairs the narrow-phase oracle found in its 2,000,000-pair run (seed
 // 20250917, pairs 415996, 666220 and 1160967 of
-// tests/cpp/test_narrow_phase_oracle.cpp), with World's settings for d0 = 1 cm:
+// tests/cpp/contact/test_narrow_phase_oracle.cpp), with World's settings for d0 = 1 cm:
 // a pair 9.19 mm apart whose entrance face ties with the face the corners lie over (no sub-contact before); a pair overlapping by 0.38 mm, same tie (no sub-contact before); a box along a slender block, edges 0.0103 rad from parallel (the entrance crossing was 6.12 mm deep for a 5.84 mm overlap). Each must keep a sub-contact, and none may be deeper than the
 // pair's overlap (its separating-axis value, every face normal and edge
 // cross product).
