@@ -13,7 +13,7 @@ the benchmark and the sweep API.
   and elastic modes leaves a velocity offset that a smaller dt resolves more
   of: on core b7154a7 the quick run's wedge is off by 1.1e-4, 4.0e-4 and
   1.0e-3 of its slide at dt 1e-2, 3e-3 and 1e-3 s, the incline by 1.0e-4,
-  4.8e-5 and 5.7e-5; README, "What accuracy costs".)
+  4.8e-5 and 5.7e-5; doc/benchmarks.md, "What accuracy costs".)
 - `yade_dda.sweep` in this process: points carry the knob value, error and
   cost; bad arguments raise ValueError naming the problem.
 

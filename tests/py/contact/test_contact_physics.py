@@ -684,7 +684,7 @@ def test_wedge_with_fs_above_one_stands(scene, name):
 
 
 def test_frictional_start_up_error_is_the_penalty_springs(scene):
-    """Why frictional slides get less accurate as dt shrinks (README, "What accuracy
+    """Why frictional slides get less accurate as dt shrinks (doc/benchmarks.md, "What accuracy
     costs"; bench/friction_startup.py). A rigid cube at rest on a 30 deg slope with
     20 deg friction, its contacts preloaded with its weight: with a dt that does not
     resolve the shear springs' period it slides as Coulomb friction says to within the

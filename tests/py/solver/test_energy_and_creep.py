@@ -125,8 +125,8 @@ def test_pile_of_200_cubes_never_gains_energy(scene, young):
     the bottom one with 1.8e5 Pa: the bottom cubes lose over half their volume, so
     this case tests the finite-strain step (BlockEquations.hpp; before it, their
     rates ran away at 1.09 s and the account's kinetic plus potential energy rose
-    89%). Measured with bench/energy.py --pile200 (the same pile), see the README's
-    *Energy of a dropped pile*. At 1e9 and 1e11 Pa the contact changes between
+    89%). Measured with bench/energy.py --pile200 (the same pile), see doc/benchmarks.md,
+    "Energy of a dropped pile". At 1e9 and 1e11 Pa the contact changes between
     steps must add no more than 1e-3 of the largest change (at 1e5 Pa sub-contacts
     of deeply overlapping soft cubes do add energy: see the 30-cube test). The
     four cases take about 5 minutes."""

@@ -3,7 +3,7 @@ break, each checked for what could go wrong.
 
 Every case runs under the common guards of `hardguards.Guard`, after every
 step: finite state; no two blocks overlapping by more than the penetration
-tolerance (README, "Penetration tolerance"), both as the core reports its
+tolerance (doc/testing.md, "Penetration tolerance"), both as the core reports its
 contacts and as the true overlap of the blocks' current shapes; no energy
 gain beyond round-off (kinetic + gravity + strain + contact springs); the
 open-close iteration never accepted unconverged and its dt cuts bounded; and

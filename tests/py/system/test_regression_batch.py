@@ -1,4 +1,4 @@
-"""Batch regressions (README, "Batch regressions"): the quick table through yade-batch and check.py.
+"""Batch regressions (doc/user-guide.md, "Batch regressions"): the quick table through yade-batch and check.py.
 
 This is how CI runs the quick table. One yade-batch run (module fixture) of
 examples/regression/quick.table plus one row that crashes on purpose, with
