@@ -6,6 +6,7 @@ bodies, their positions, O.iter, O.time and the DDA step count. Cases that
 are documented behaviour rather than errors assert that behaviour.
 """
 import math
+import random
 
 import pytest
 from yade import utils, wrapper
@@ -98,9 +99,16 @@ def test_sliver_of_nearly_collinear_points_is_rejected_not_an_internal_error(sce
 
 
 def test_block_yade_cannot_represent_is_rejected_before_it_is_added(scene):
-    """A 1e9 m cube: YADE's Polyhedra merged two corners and the first step failed in the link."""
-    refused(ValueError, r"YADE's Polyhedra shape of this block has 7 corners instead of 8",
+    """A 1e9 m cube: YADE's Polyhedra merged two corners and the first step failed in the link; a
+    random 30-point cloud 1e5 m across hangs YADE's hull or aborts the process. Both are refused by
+    their size before YADE sees them (with or without hull=True); 1e4 m is still a block."""
+    refused(ValueError, r"the block is 1e\+09 m across .* more than the 10000 m YADE's Polyhedra can carry",
             lambda: ddaBlock(box((0, 0, 0), (1e9, 1e9, 1e9))))
+    rng = random.Random(5)
+    cloud = [(1e5 * rng.random(), 1e5 * rng.random(), 1e5 * rng.random()) for _ in range(30)]
+    refused(ValueError, r'the block is 9\d{4}\.\d m across', lambda: ddaBlock(cloud, hull=True))
+    body = ddaBlock(box((0, 0, 0), (1e4, 1e4, 1e4)))
+    assert len(body.shape.v) == 8
 
 
 @pytest.mark.parametrize('vertices, error, match', [
