@@ -173,7 +173,7 @@ class DDAVTKRecorder(Engine, wrapper.PyRunner):
 
 def command(fileName):
     """The command of a recorder writing under fileName (what a saved scene's PyRunner runs)."""
-    return 'import yade_dda.recorder as _ddaVtk; _ddaVtk.record(%r)' % (fileName,)
+    return 'import yade_dda.recorder as _ddaVtk; _ddaVtk.record(%r, fromEngine=True)' % (fileName,)
 
 
 def _requirePeriod(periods):
@@ -192,11 +192,13 @@ def _requireVtk():
 
 # ------------------------------------------------------------------ one output
 
-def record(fileName):
-    """One output under fileName: the blocks, the contacts and both series
-    (DDAVTKRecorder's command calls it). Returns (blocks path, contacts path)."""
+def record(fileName, fromEngine=False):
+    """One output under fileName: the blocks, the contacts and both series.
+    DDAVTKRecorder's command calls it with fromEngine=True (the state's
+    iteration and time then depend on the engine's place, see _stateClock);
+    a script may call it between iterations. Returns (blocks path, contacts path)."""
     _checkFileName(fileName)
-    iteration, time = _stateClock(fileName)
+    iteration, time = _stateClock(fileName) if fromEngine else (O.iter, O.time)
     scene = _scene.current(create=False)
     if scene is not None:
         scene.resolvePending()   # blocks appended since the last step are in the core, as the next step sees them
@@ -231,12 +233,13 @@ def _collectorPaused():
 
 
 def _stateClock(fileName):
-    """(iteration, time) of the core's state now: O.iter and O.time before the
-    integrator has stepped in this iteration, O.iter + 1 and O.time + O.dt after."""
+    """(iteration, time) of the core's state when the recorder under fileName
+    runs as an engine: O.iter and O.time when it stands before the integrator,
+    O.iter + 1 and O.time + O.dt (booked by YADE when the iteration ends) after it."""
     mine = command(fileName)
     engines = list(O.engines)
     position = next((k for k, e in enumerate(engines) if isinstance(e, wrapper.PyRunner) and e.command == mine), None)
-    if position is None:   # called from a script, not as an engine: the state between iterations
+    if position is None:   # run by an engine that is not in O.engines (e.g. O.engines was replaced)
         return O.iter, O.time
     for engine in engines[:position]:
         if isinstance(engine, wrapper.PyRunner) and not engine.dead and engine.command.startswith(INTEGRATOR_COMMAND):
@@ -272,10 +275,11 @@ def _topology(scene, views):
     vertex ids, a mask of the stream's vertex ids, the block of each stream
     entry, the stream offset of each block) for the blocks of views. A block's
     faces never change (DDA deforms each block affinely), so they are read once
-    per core scene and the arrays are rebuilt only when blocks were added."""
+    per DDA scene (its token: a loaded or cleared scene gets a new one) and the
+    arrays are rebuilt only when blocks were added."""
     cached = _topologyCache.get('scene')
-    if cached is None or cached['core'] is not scene.core or cached['blocks'] > len(views):
-        cached = _topologyCache['scene'] = dict(core=scene.core, blocks=0, counts=[], streams=[], masks=[],
+    if cached is None or cached['token'] != scene.token or cached['blocks'] > len(views):
+        cached = _topologyCache['scene'] = dict(token=scene.token, blocks=0, counts=[], streams=[], masks=[],
                                                 arrays=None)
     if cached['blocks'] < len(views):
         for view in views[cached['blocks']:]:

@@ -211,6 +211,8 @@ def test_the_series_lists_every_output_at_the_time_of_its_state(scene, tmp_path,
         assert [t for t, _ in series] == [times[i] for i in iterations]
         assert [p for _, p in series] == ['%s%s.%010d.%s' % (prefix, what, i, extension) for i in iterations]
         assert all(os.path.isfile(p) for _, p in series)
+    recorder.record(prefix)   # from the script, between iterations: O.iter and O.time wherever the engine stands
+    assert recorder.readSeries(prefix + 'blocks.pvd')[-1] == (times[30], '%sblocks.%010d.vtu' % (prefix, 30))
     for time, path in recorder.readSeries(prefix + 'blocks.pvd'):
         zLow = _points(_read(path))[:, 2].min()
         assert zLow == pytest.approx(10 - G * time ** 2 / 2, abs=1e-9)
@@ -263,12 +265,13 @@ def test_parameters_reach_the_engine_and_the_command(scene, tmp_path):
     rec = DDAVTKRecorder(fileName=str(tmp_path / 'made' / 'here' / 'p-'), virtPeriod=0.5, label='vtk')
     assert os.path.isdir(str(tmp_path / 'made' / 'here'))
     assert (rec.iterPeriod, rec.virtPeriod, rec.realPeriod, rec.initRun) == (0, 0.5, 0.0, True)
-    assert rec.command == "import yade_dda.recorder as _ddaVtk; _ddaVtk.record(%r)" % str(tmp_path / 'made/here/p-')
+    assert rec.command == ("import yade_dda.recorder as _ddaVtk; _ddaVtk.record(%r, fromEngine=True)"
+                           % str(tmp_path / 'made/here/p-'))
     rec.iterPeriod = 3.0
     assert rec.iterPeriod == 3 and type(rec.iterPeriod) is int
     rec.virtPeriod = 0
     rec.fileName = str(tmp_path / 'q-')
-    assert rec.command.endswith("record(%r)" % str(tmp_path / 'q-'))
+    assert rec.command.endswith("record(%r, fromEngine=True)" % str(tmp_path / 'q-'))
     rec.nDo = 5   # YADE's own
 
 
