@@ -4,7 +4,7 @@ PYTHON   := /usr/bin/python3
 BUILD    := build
 JOBS     ?= 2
 DEB_PACKAGES := yade cmake g++ make libeigen3-dev libcgal-dev libgmp-dev libmpfr-dev \
-                libboost-python-dev python3-dev python3-pytest python3-numpy python3-matplotlib \
+                libboost-python-dev python3-dev python3-pytest python3-numpy python3-matplotlib python3-vtk9 \
                 libgtest-dev
 SITE_DIR := $(shell $(PYTHON) -c "import sysconfig;print(sysconfig.get_path('purelib','posix_local'))" 2>/dev/null)
 
