@@ -52,7 +52,7 @@ public:
 	// World::reserveBlocks, and as much room in the body links.
 	void reserveBlocks(int extra);
 	int blockCount() const { return world.blockCount(); }
-	double sceneHalfSize() { return world.sceneHalfSize(); }
+	double motionHalfSize() { return world.motionHalfSize(); }
 	double time() const { return world.time(); }
 	long steps() const { return world.steps(); }
 

@@ -482,7 +482,7 @@ BOOST_PYTHON_MODULE(_core) {
 	    .def("step", &step)
 	    .def("syncData", &syncData)
 	    .def("lastStep", &lastStep)
-	    .def("sceneHalfSize", &SceneLink::sceneHalfSize)
+	    .def("motionHalfSize", &SceneLink::motionHalfSize)
 	    .def("time", &SceneLink::time)
 	    .def("steps", &SceneLink::steps)
 	    .def("saveState", &saveState, "The whole DDA scene (blocks, contacts and their history, counters) as bytes.")

@@ -1,5 +1,6 @@
 #include "InitialOverlaps.hpp"
 
+#include "TimeStepControl.hpp"
 #include "dda/contact/PairDetection.hpp"
 
 #include <Eigen/Geometry>
@@ -16,17 +17,18 @@ std::vector<InitialOverlap> findInitialOverlaps(const std::vector<const Block*>&
 	const int n = static_cast<int>(blocks.size());
 	if (firstNew >= n) return found;
 	std::vector<Eigen::AlignedBox3d> boxes(n);
-	Eigen::AlignedBox3d scene;
 	double weight = 0;
 	for (int b = 0; b < n; ++b) {
 		for (const Vector3& x : blocks[b]->vertices) boxes[b].extend(x);
-		scene.extend(boxes[b]);
 		if (!blocks[b]->fixed) weight += blocks[b]->mass;
 	}
 	weight *= settings.gravity.norm();
 	// d0 as World::step takes it at the first step after blocks were added.
-	const double allowed = settings.maxDisplacement > 0 ? settings.maxDisplacement
-	                                                    : settings.maxDisplacementRatio * 0.5 * scene.sizes().maxCoeff();
+	const double allowed = TimeStepControl::allowedDisplacement(settings, [&] {
+		return TimeStepControl::motionHalfSize(
+		    n, [&](int k) -> const std::vector<Vector3>& { return blocks[k]->vertices; },
+		    [&](int k) { return blocks[k]->fixed; });
+	});
 	const double d0 = settings.contactDistance > 0 ? settings.contactDistance : settings.contactDistanceFactor * allowed;
 
 	// Sweep along x: pairs whose boxes overlap (a pair deeper than any

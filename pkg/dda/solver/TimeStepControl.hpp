@@ -9,6 +9,8 @@
 
 #include "IntegratorSettings.hpp"
 
+#include <Eigen/Geometry>
+
 namespace dda {
 
 // The smallest volume ratio det(I + S) an attempt gives a deformable block [-],
@@ -24,12 +26,29 @@ class StateReader;
 class TimeStepControl {
 public:
 	// Largest vertex displacement allowed in one step [m]: maxDisplacement, or
-	// without it maxDisplacementRatio x sceneHalfSize() (Shi's g2 x w0) [m].
-	// sceneHalfSize is called only then (World measures w0 when first asked).
-	template <class SceneHalfSize>
-	static double allowedDisplacement(const IntegratorSettings& settings, SceneHalfSize&& sceneHalfSize) {
+	// without it maxDisplacementRatio x motionHalfSize() (Shi's g2 x w0) [m].
+	// motionHalfSize is called only then (World measures w0 when first asked).
+	template <class MotionHalfSize>
+	static double allowedDisplacement(const IntegratorSettings& settings, MotionHalfSize&& motionHalfSize) {
 		return settings.maxDisplacement > 0 ? settings.maxDisplacement
-		                                    : settings.maxDisplacementRatio * sceneHalfSize();
+		                                    : settings.maxDisplacementRatio * motionHalfSize();
+	}
+	// Shi's w0 [m]: half the largest side of the bounding box of the blocks
+	// that move (of all blocks when none moves). Fixed blocks are left out: a
+	// 46 m floor under 1 m blocks made w0 23 m, so the default step could move
+	// a block 0.23 m and d0 reached 0.575 m, half the blocks' size, where
+	// from the moving blocks' own extent both follow the blocks. `corners(k)`
+	// gives block k's vertices, `fixed(k)` whether it is fixed.
+	template <class Corners, class Fixed>
+	static double motionHalfSize(int blockCount, Corners&& corners, Fixed&& fixed) {
+		for (const bool movingOnly : {true, false}) {
+			Eigen::AlignedBox3d box;
+			for (int k = 0; k < blockCount; ++k)
+				if (!movingOnly || !fixed(k))
+					for (const Vector3& x : corners(k)) box.extend(x);
+			if (!box.isEmpty()) return 0.5 * box.sizes().maxCoeff();
+		}
+		return 0.0;
 	}
 	// The dt a step tries first [s].
 	double firstTry(const IntegratorSettings& settings) const;

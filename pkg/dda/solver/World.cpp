@@ -106,15 +106,14 @@ void World::setStress(int index, const Vector6& stress) {
 	b.stress = stress;
 }
 
-double World::sceneHalfSize() {
-	if (sceneSizedBlocks_ != blockCount()) {
-		Eigen::AlignedBox3d box;
-		for (const Block& b : blocks_)
-			for (const Vector3& x : b.vertices) box.extend(x);
-		sceneHalfSize_ = box.isEmpty() ? 0.0 : 0.5 * box.sizes().maxCoeff();
-		sceneSizedBlocks_ = blockCount();
+double World::motionHalfSize() {
+	if (motionSizedBlocks_ != blockCount()) {
+		motionHalfSize_ = TimeStepControl::motionHalfSize(
+		    blockCount(), [this](int k) -> const std::vector<Vector3>& { return blocks_[k].vertices; },
+		    [this](int k) { return blocks_[k].fixed; });
+		motionSizedBlocks_ = blockCount();
 	}
-	return sceneHalfSize_;
+	return motionHalfSize_;
 }
 
 void World::setCollider(std::unique_ptr<Collider> collider) {
@@ -147,7 +146,7 @@ double World::advance(const IntegratorSettings& settings) {
 	const auto stepStart = Clock::now();
 	StepStatistics stats;
 	stats.blocks = blockCount();
-	stats.allowedDisplacement = TimeStepControl::allowedDisplacement(settings, [this] { return sceneHalfSize(); });
+	stats.allowedDisplacement = TimeStepControl::allowedDisplacement(settings, [this] { return motionHalfSize(); });
 	stats.contactDistance = stepContactDistance(settings, stats.allowedDisplacement);
 	detection_.detect(blocks_, *collider_, store_, settings, frictionScale_, stats);
 	if (settling_ && frozen_.empty()) markSettlingBlocks();

@@ -85,9 +85,10 @@ public:
 	// (searchLine). On by default; the results are bitwise the same (off for
 	// tests).
 	void setSolverReuse(bool reuse) { openClose_.setSolverReuse(reuse); }
-	// Half the largest extent of the bounding box of all blocks [m] (Shi's w0),
-	// measured at the first step after blocks were added.
-	double sceneHalfSize();
+	// Shi's w0 [m]: half the largest extent of the bounding box of the moving
+	// blocks (TimeStepControl::motionHalfSize), measured at the first step
+	// after blocks were added.
+	double motionHalfSize();
 
 	// Saving (WorldState.cpp): writes every member that affects later steps,
 	// in container order (contact order decides summation order, hence
@@ -148,8 +149,8 @@ private:
 	Vector3 gravity_ = Vector3::Zero();
 	double time_ = 0;
 	long steps_ = 0;
-	double sceneHalfSize_ = 0;
-	int sceneSizedBlocks_ = -1;  // block count when sceneHalfSize_ was measured
+	double motionHalfSize_ = 0;
+	int motionSizedBlocks_ = -1;  // block count when motionHalfSize_ was measured
 };
 
 }  // namespace dda

@@ -243,8 +243,8 @@ void World::writeState(StateWriter& out) const {
 	out.pod(time_);
 	out.pod(steps_);
 	timeStep_.writeState(out);  // next dt, open-close failures, displacement-limit misses
-	out.pod(sceneHalfSize_);
-	out.pod(sceneSizedBlocks_);
+	out.pod(motionHalfSize_);
+	out.pod(motionSizedBlocks_);
 	detection_.writeState(out);  // the flush-joint faces
 	out.size(sizeof(StepStatistics));
 	out.pod(stats_);
@@ -285,8 +285,8 @@ void World::readState(StateReader& in) {
 	in.pod(w.time_);
 	in.pod(w.steps_);
 	w.timeStep_.readState(in);
-	in.pod(w.sceneHalfSize_);
-	in.pod(w.sceneSizedBlocks_);
+	in.pod(w.motionHalfSize_);
+	in.pod(w.motionSizedBlocks_);
 	w.detection_.readState(in);
 	const std::size_t statsBytes = in.size(1, "statistics bytes");
 	if (statsBytes == sizeof(StepStatistics)) {
