@@ -158,7 +158,7 @@ public:
 	long totalShellUpdates() const { return totalShellUpdates_; }
 	long coverBuilds() const { return coverBuilds_; }
 
-	// Saving (MultiShellCoverState.cpp; the layout is MSCColliderState's).
+	// Saving (MultiShellCoverState.cpp: the file layout, kept since covers were first saved).
 	void write(StateWriter& out) const;
 	// Reads into a fresh cover and lays its shells out; the boxes of blocks
 	// whose shells were built while fixed are computed again.
