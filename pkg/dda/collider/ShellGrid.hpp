@@ -13,6 +13,7 @@
 
 #include <Eigen/Geometry>
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <utility>
