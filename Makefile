@@ -4,7 +4,7 @@ PYTHON   := /usr/bin/python3
 BUILD    := build
 JOBS     ?= 2
 DEB_PACKAGES := yade cmake g++ make libeigen3-dev libcgal-dev libgmp-dev libmpfr-dev \
-                libboost-python-dev python3-dev python3-pytest python3-numpy python3-matplotlib \
+                libboost-python-dev python3-dev python3-pytest python3-numpy python3-matplotlib python3-vtk9 \
                 libgtest-dev
 SITE_DIR := $(shell $(PYTHON) -c "import sysconfig;print(sysconfig.get_path('purelib','posix_local'))" 2>/dev/null)
 
@@ -36,7 +36,7 @@ test: install
 	$(PYTHON) -m pytest -q tests/py
 
 # Everything `test` runs plus the cases marked slow (pytest.ini deselects them by default), and the
-# narrow-phase oracle (tests/cpp/test_narrow_phase_oracle.cpp) on 2,000,000 random pairs instead of
+# narrow-phase oracle (tests/cpp/contact/test_narrow_phase_oracle.cpp) on 2,000,000 random pairs instead of
 # 100,000 (about 6 minutes; DDA_ORACLE_SEED picks another sample).
 ORACLE_PAIRS ?= 2000000
 test-hard: install
@@ -60,7 +60,7 @@ bench-pile200: install
 
 # The parameter reference doc/parameters.md, generated from the settings' one declaration
 # (pkg/dda/solver/Settings.def) through the built module by tools/gen_docs.py;
-# tests/py/test_parameter_reference.py fails when it is stale.
+# tests/py/package/test_parameter_reference.py fails when it is stale.
 docs: build
 	YADE_DDA_BUILD=$(abspath $(BUILD))/py $(PYTHON) tools/gen_docs.py
 
@@ -69,7 +69,7 @@ docs: build
 fingerprints: install
 	$(PYTHON) bench/fingerprints.py
 
-# Batch regressions (README, "Batch regressions"): yade-batch runs every row of a table in
+# Batch regressions (doc/user-guide.md, "Batch regressions"): yade-batch runs every row of a table in
 # examples/regression, each scene writes a record, check.py compares them with closed forms and
 # stored references and exits non-zero on any failure. Logs and records go to $(REGRESS_OUT)/<table>.
 REGRESS_OUT := $(BUILD)/regress
@@ -91,7 +91,7 @@ regress-run:
 	    --log "$$out/@.log" $(TABLE).table 2>&1) | tee $$out/yade-batch.log | grep --line-buffered -E '^#[0-9]+ \('; true
 	$(PYTHON) examples/regression/check.py examples/regression/$(TABLE).table $(abspath $(REGRESS_OUT))/$(TABLE) $(CHECK_ARGS)
 
-# Longer fuzzing of the geometry and contact kernels (README, "Bad input"): tests/fuzz's target built
+# Longer fuzzing of the geometry and contact kernels (doc/testing.md, "Fuzzing"): tests/fuzz's target built
 # with AddressSanitizer and UBSan in its own build tree, fed by the plain driver for FUZZ_SECONDS with
 # a seed from the clock (printed; findings are written to $(FUZZ_BUILD)/crashes). ctest runs the same
 # target for 20 s without sanitizers.
@@ -105,7 +105,7 @@ fuzz: deps
 	ASAN_OPTIONS=detect_leaks=0 $(FUZZ_BUILD)/fuzz_kernels_driver --seconds $(FUZZ_SECONDS) --seed $$(date +%s) \
 	    --crash-dir $(FUZZ_BUILD)/crashes tests/fuzz/corpus
 
-# Mutation checks of the hard-case suite (README, "Mutation checks"): each patch in tests/mutations
+# Mutation checks of the hard-case suite (doc/testing.md, "Mutation checks"): each patch in tests/mutations
 # removes one core protection; run.py builds the module for the unmutated tree, then for each patch,
 # in one incremental build tree ($(MUTATION_BUILD)), and runs the tests the patch names: the
 # unmutated tree must pass them and each mutation must make one fail. Long (a build per mutation),

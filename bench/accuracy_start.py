@@ -1,4 +1,4 @@
-"""Where the frictional slides' error comes from (README, "What accuracy costs").
+"""Where the frictional slides' error comes from (doc/benchmarks.md, "What accuracy costs").
 
 Runs bench/accuracy.py's incline (30 deg, 20 deg friction) and wedge (FS 0.8)
 for 1 s at dt = 1e-2, 1e-3 and 1e-4 s, with the moving block deformable (the

@@ -8,7 +8,7 @@ height (the restitution of the energy; the apex is sampled every 10 steps), the
 mechanical energy (stats()['energy']: kinetic with rotation and strain rates, plus
 gravity, strain and contact) at that apex over the drop energy, and the wall time.
 
-What it shows (README, "What accuracy costs"): Shi's scheme damps the contact's
+What it shows (doc/benchmarks.md, "What accuracy costs"): Shi's scheme damps the contact's
 vibration, so the bounce loses most of its energy unless dt resolves the contact
 (pi sqrt(m / 4 kn)); average acceleration with its secant contact force keeps a
 rigid cube's energy exactly at any dt, and a deformable cube's within about 2% (the

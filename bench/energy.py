@@ -23,14 +23,14 @@ Run: make bench (or /usr/bin/python3 bench/energy.py [--youngs 1e5 1e11] [--time
 YADE_DDA_BUILD=<build>/py to use a build tree instead of the installed package).
 
 --pile200: the issue's scene instead, the pile of
-tests/py/test_energy_and_creep.py::test_pile_of_200_cubes_never_gains_energy
+tests/py/solver/test_energy_and_creep.py::test_pile_of_200_cubes_never_gains_energy
 (200 cubes in 8 layers of 5 x 5, 0.2 m apart, the same seed and builder), for
 1.5 s, gain and speed sampled at every step (allLandedAt: when the last cube
 left its free fall); a run stops early once a block is --stop-speed (10) times
 its free-fall bound, or gainFull is above --stop-gain (0.5) (recorded as
 `stopped`); writes
 bench/out/energy_pile200.json. Not in `make bench`: it takes many minutes per
-E (see README, *Energy of a dropped pile*). --count/--side run
+E (see doc/benchmarks.md, "Energy of a dropped pile"). --count/--side run
 other piles of that builder (written to energy_pile<count>.json). --threads
 sets DDAIntegrator.threads (results do not depend on it; 1 is fair to other
 users of the machine).
@@ -51,6 +51,7 @@ from yade_dda import O, ddaBlock, DDAIntegrator, block  # noqa: E402
 from yade import wrapper  # noqa: E402
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'tests', 'py'))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'tests', 'py', 'solver'))
 from helpers import box, rotate  # noqa: E402  (the tests' shapes: same piles as test_energy_and_creep.py)
 
 G = 9.81

@@ -8,7 +8,7 @@ corner contacts start preloaded (each compressed by m g cos a / (4 kn), the
 share of the weight it carries at rest) or unloaded, and for a deformable
 block, against dt and the penalty factor.
 
-What it shows (README, "What accuracy costs"): the error is the penalty
+What it shows (doc/benchmarks.md, "What accuracy costs"): the error is the penalty
 model's start-up, not the time scheme's. In the first step the contacts
 are locked and their shear springs stretch while the block accelerates; a
 dt that resolves the springs' period lets the block leave that step faster

@@ -1,5 +1,5 @@
 # -*- coding: utf-8 -*-
-"""A scene for the accuracy sweep (README, "What accuracy costs"): your own scene has the same shape.
+"""A scene for the accuracy sweep (doc/benchmarks.md, "Your own scene"): your own scene has the same shape.
 
 A 1 m cube of rock slides across a fixed floor with v0 = 2 m/s and stops by
 Coulomb friction (phi = 30 deg). Closed form: the deceleration is g tan(phi),
@@ -12,7 +12,7 @@ spring held the whole step's slip and tipped the cube, and the tipped solve's
 normal force drove the next solve's friction (speed 2.0 -> 1.2 m/s in one
 step). New contacts whose blocks move apart tangentially now start sliding,
 and sliding contacts iterate until their normal force settles; the same
-physics is a test (tests/py/test_contact_physics.py,
+physics is a test (tests/py/contact/test_contact_physics.py,
 test_block_launched_along_floor_slides_to_a_stop).
 
 The sweep needs three names (SI units):

@@ -5,7 +5,7 @@ built module as yade_dda._core.settingsTable()).
 Run:  make docs
       YADE_DDA_BUILD=build/py /usr/bin/python3 tools/gen_docs.py [--check]
 --check writes nothing and exits 1 when doc/parameters.md is stale.
-tests/py/test_parameter_reference.py makes the same check in the test run.
+tests/py/package/test_parameter_reference.py makes the same check in the test run.
 """
 import argparse
 import os

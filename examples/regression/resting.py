@@ -17,7 +17,7 @@ centroid's drop w0 and the strains (ex = ey = e by symmetry, ez) gives:
 (M = lambda + 2 mu = E (1 - nu)/((1 + nu)(1 - 2 nu)) the constrained modulus.)
 Frictionless (phiDeg = 0): the corners slide, no shear springs, e = -nu ez:
 uniaxial stress, ez = -rho g h / (2E). Friction that locks the corners: as
-ks -> infinity this is the confined column of tests/py/test_motion.py,
+ks -> infinity this is the confined column of tests/py/blocks/test_motion.py,
 ez = -rho g h / (2M); the shear springs' compliance leaves e = 2.5e-8 and
 ez 1.5% above the confined value. Locking needs tan(phi) above the corner's
 shear demand |F_shear|/N = sqrt(2) ks e a / 2 / (m g / 4) (= 0.44 here); between

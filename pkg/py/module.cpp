@@ -60,6 +60,13 @@ void checkBlock(const py::object& points, double density, double young, double p
 	buildConvexPolyhedron(toPoints(points, "block vertices"));
 }
 
+// hullCorners as a Python list of indices (ddaBlock(..., hull=True)).
+py::list pythonHullCorners(const py::object& points) {
+	py::list out;
+	for (int i : hullCorners(toPoints(points, "hull points"))) out.append(i);
+	return out;
+}
+
 // One tuple per sub-contact: (block i, block j, kind, structural type, state,
 // normal from j to i, point, normal force [N], shear force on i [N], gap at the
 // start of the step [m], bonded).
@@ -415,6 +422,11 @@ BOOST_PYTHON_MODULE(_core) {
 	        (py::arg("points"), py::arg("density"), py::arg("young"), py::arg("poisson"), py::arg("frictionAngle") = 0.0,
 	         py::arg("cohesion") = 0.0, py::arg("tensileStrength") = 0.0),
 	        "Raises ValueError naming the problem if the points and material cannot make a DDA block.");
+
+	py::def("hullCorners", &pythonHullCorners, py::arg("points"),
+	        "Indices of the points [m] that are the corners of their convex hull, in input order (points inside the "
+	        "hull, repeats and points on a face or an edge of it within the coplanar tolerance are left out); "
+	        "ValueError for fewer than 4 points, NaN or inf, or no volume.");
 
 	py::scope().attr("mscMaxSegments") = kMaxCoverSegments;
 

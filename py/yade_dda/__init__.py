@@ -21,6 +21,7 @@ from .hooks import installHooks
 from .blocks import ddaBlock, rigidBlock
 from .engines import DDAIntegrator
 from .colliders import MSCCollider, DESSCollider, NBSCollider, AllPairsCollider
+from .recorder import DDAVTKRecorder
 from .saveload import Checkpoint, latestCheckpoint, writeCheckpoint, storeState, restoreState
 from .scene import (stats, sync, block, blockOf, setVelocity, addPointLoad, addFixedPoint,
                     printStats, contacts, Ig2_DDABlock_DDABlock_DDAContact)
@@ -28,7 +29,7 @@ from .scene import (stats, sync, block, blockOf, setVelocity, addPointLoad, addF
 installHooks()
 
 __all__ = ['ddaBlock', 'rigidBlock', 'DDAIntegrator', 'MSCCollider', 'DESSCollider', 'NBSCollider', 'AllPairsCollider',
-           'Checkpoint', 'latestCheckpoint', 'stats', 'printStats', 'sync', 'block', 'blockOf',
+           'Checkpoint', 'latestCheckpoint', 'DDAVTKRecorder', 'stats', 'printStats', 'sync', 'block', 'blockOf',
            'setVelocity', 'addPointLoad', 'addFixedPoint', 'contacts', 'Ig2_DDABlock_DDABlock_DDAContact', 'O']
 
 _TOOLS = ('compare', 'accuracy', 'regression', 'compareColliders', 'sweep')

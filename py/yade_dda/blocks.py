@@ -1,5 +1,6 @@
 """Making DDA blocks: YADE bodies with a Polyhedra shape, backed by the DDA core."""
 import math
+import random
 
 from ._yade import O, utils, wrapper
 from . import _core
@@ -25,6 +26,15 @@ class BlockSpec:
             return self.points
         x, y, z = self.shift
         return [(p[0] + x, p[1] + y, p[2] + z) for p in self.points]
+
+
+_PALETTE = random.Random(20140101)
+"""Colours of blocks made without one: a generator of our own, so Python's ``random`` (which YADE's
+``randomColor`` draws from) is left alone and a script's colours are the same on every run."""
+
+
+def _nextColor():
+    return tuple(_PALETTE.random() for _ in range(3))
 
 
 def _finiteNonNegative(value, what, unit):
@@ -122,7 +132,7 @@ def _elasticConstants(material):
 
 def ddaBlock(vertices, material=None, fixed=False, color=None, velocity=(0, 0, 0),
              angularVelocity=(0, 0, 0), fixedPoints=(), loads=(), stress=None, mask=1, wire=False,
-             cohesion=0.0, tensileStrength=0.0, rigid=False):
+             cohesion=0.0, tensileStrength=0.0, rigid=False, hull=False):
     """A DDA block as a YADE Body, ready for ``O.bodies.append``.
 
     The block is the convex polyhedron whose corners are ``vertices`` [m]
@@ -162,6 +172,14 @@ def ddaBlock(vertices, material=None, fixed=False, color=None, velocity=(0, 0, 0
         area. A bond breaks for good when shear exceeds friction plus
         cohesion x area, or tension exceeds tensileStrength x area.
     :param tensileStrength: joint tensile strength [Pa] of bonded joints.
+    :param hull: True: the block is the convex hull of ``vertices``, any
+        points (a bool). Points inside the hull, repeats, and points on its
+        surface that are no corner (inside a face or an edge, or a corner so
+        flat that YADE's ``Polyhedra`` or the core merges the faces around
+        it, within 1e-9 of the bounding-box diagonal) are left out, so the YADE shape
+        and the DDA block have the same corners. The block's volume is the
+        hull's, less what those merges cut off: at most the merge tolerance
+        times the hull's area. ``block(body).vertices`` are the corners kept.
 
     Raises ValueError naming the problem for bad geometry (fewer than 4 points,
     coplanar, duplicated, NaN/inf, a point that is not a corner of the hull),
@@ -176,12 +194,17 @@ def ddaBlock(vertices, material=None, fixed=False, color=None, velocity=(0, 0, 0
     """
     if not isinstance(rigid, bool):
         raise TypeError('rigid must be True or False, got %r' % (rigid,))
+    if not isinstance(hull, bool):
+        raise TypeError('hull must be True or False, got %r' % (hull,))
     points = _points(vertices)
+    if hull:
+        points = [points[i] for i in _core.hullCorners(points)]
     mat = _material(material)
     density, young, poisson, frictionAngle = _elasticConstants(mat)
     cohesion = _finiteNonNegative(cohesion, 'cohesion', 'Pa')
     tensileStrength = _finiteNonNegative(tensileStrength, 'tensileStrength', 'Pa')
     _core.checkBlock(points, density, young, poisson, frictionAngle, cohesion, tensileStrength)
+    _requireYadeSize(points)
     velocity = vector(velocity, 'velocity')
     angularVelocity = vector(angularVelocity, 'angularVelocity')
     if fixed and (any(velocity) or any(angularVelocity)):
@@ -217,23 +240,12 @@ def ddaBlock(vertices, material=None, fixed=False, color=None, velocity=(0, 0, 0
                              '(make the block deformable, or drop the stress)' % (stress,))
     if not isinstance(mask, int) or isinstance(mask, bool):
         raise TypeError('mask must be an int, got %r' % (mask,))
-    if color is not None:
-        color = vector(color, 'color')
+    color = vector(color, 'color') if color is not None else _nextColor()
 
-    # YADE's shape is made from the corners shifted near the origin (see _nearOrigin); the body is then put
-    # back: pos = shift + YADE's centroid (rounded; SceneLink's vertex match allows for it). The spec keeps
-    # the shifted tuples, which YADE's converter keeps anyway (see _points), and the shift, not a second copy.
-    yadePoints, shift = _nearOrigin(points)
-    body = utils.polyhedron(yadePoints, fixed=fixed, wire=wire, color=color, material=mat, mask=mask)
-    if shift is not None:
-        pos = body.state.pos
-        body.state.pos = body.state.refPos = (pos[0] + shift[0], pos[1] + shift[1], pos[2] + shift[2])
-    if len(body.shape.v) != len(points):
-        # YADE's Polyhedra builds its own hull with its own tolerances (absolute ones: a 1e9 m cube lost a
-        # corner). Its distance from the origin no longer matters (the corners were shifted), its size does.
-        raise ValueError('YADE\'s Polyhedra shape of this block has %d corners instead of %d (YADE merged corners '
-                         'its own absolute tolerances cannot tell apart, for a block of this size); rescale the block'
-                         % (len(body.shape.v), len(points)))
+    body, corners, yadePoints, shift = _body(points, hull, dict(fixed=fixed, wire=wire, color=color, material=mat,
+                                                                 mask=mask))
+    if len(corners) != len(points):   # hull=True, and YADE merged corners away
+        _core.checkBlock(corners, density, young, poisson, frictionAngle, cohesion, tensileStrength)
     if not fixed:
         body.state.vel = velocity
         body.state.angVel = angularVelocity
@@ -244,6 +256,59 @@ def ddaBlock(vertices, material=None, fixed=False, color=None, velocity=(0, 0, 0
                      fixedPoints=tuple(fixedList), loads=tuple(loadList), stress=stress)
     _scene.current().register(body, spec)
     return body
+
+
+MAX_EXTENT = 1e4
+"""The largest extent of a block [m] (its corners' largest bounding-box side) that YADE's Polyhedra
+carries: measured on YADE 2023.02a with random 30-point clouds, its absolute tolerances drop true corners
+from about 1e4 m (ddaBlock then refuses the block, or with hull=True drops them too) and from about 1e5 m
+its hull hangs or corrupts the heap (malloc aborts the process). Refused before YADE sees the block."""
+
+
+def _requireYadeSize(points):
+    extent = max(max(p[k] for p in points) - min(p[k] for p in points) for k in range(3))
+    if not extent <= MAX_EXTENT:
+        raise ValueError('the block is %g m across (the largest side of its corners\' bounding box), more than the '
+                         '%g m YADE\'s Polyhedra can carry (its absolute tolerances drop true corners of larger '
+                         'blocks, and from about 1e5 m its hull hangs or crashes); split it into blocks of at most '
+                         '%g m' % (extent, MAX_EXTENT, MAX_EXTENT))
+
+
+def _body(points, hull, options):
+    """(body, corners, YADE's corners, shift): the YADE body with a Polyhedra shape of `points` [m].
+
+    YADE's shape is made from the corners shifted near the origin (see _nearOrigin); the body is then put
+    back: pos = shift + YADE's centroid (rounded; SceneLink's vertex match allows for it). The spec keeps
+    the shifted tuples, which YADE's converter keeps anyway (see _points), and the shift, not a second copy.
+    YADE's Polyhedra builds its own hull with its own, absolute tolerances (a 1e9 m cube lost a corner);
+    its distance from the origin no longer matters (the corners were shifted), its size does. A corner it
+    merges away refuses the block, or with `hull` drops that corner too (the hull of what YADE kept, which
+    the core accepts as it is: a subset of a hull's corners)."""
+    for attempt in range(4):
+        yadePoints, shift = _nearOrigin(points)
+        body = utils.polyhedron(yadePoints, **options)
+        if shift is not None:
+            pos = body.state.pos
+            body.state.pos = body.state.refPos = (pos[0] + shift[0], pos[1] + shift[1], pos[2] + shift[2])
+        if len(body.shape.v) == len(points):
+            return body, points, yadePoints, shift
+        if not hull:
+            break
+        kept = _cornersYadeKept(body, points)
+        points = [kept[i] for i in _core.hullCorners(kept)]
+    raise ValueError('YADE\'s Polyhedra shape of this block has %d corners instead of %d (YADE merged corners '
+                     'its own absolute tolerances cannot tell apart, for a block of this size); rescale the block'
+                     '%s' % (len(body.shape.v), len(points), '' if hull else ', or pass hull=True to drop them'))
+
+
+def _cornersYadeKept(body, points):
+    """The points [m] nearest to the corners of the body's Polyhedra, in input order."""
+    pos, ori = body.state.pos, body.state.ori
+    kept = set()
+    for v in body.shape.v:
+        x = pos + ori * v
+        kept.add(min(range(len(points)), key=lambda i: sum((points[i][k] - x[k]) ** 2 for k in range(3))))
+    return [points[i] for i in sorted(kept)]
 
 
 def rigidBlock(vertices, material=None, **kw):

@@ -21,7 +21,7 @@ from . import guards as _guards
 from . import params as _settings
 from . import scene as _scene
 from .guards import COLLIDER_COMMAND
-from .params import Parameter, finite, initEngine
+from .params import Engine, Parameter, finite, initEngine
 
 
 def _select(name, **parameters):
@@ -42,7 +42,7 @@ def _select(name, **parameters):
     scene.colliderChoice = (O.iter, name, parameters)
 
 
-class _ColliderEngine(wrapper.PyRunner):
+class _ColliderEngine(Engine, wrapper.PyRunner):
     """Common part: typed parameters kept in the command string, every step from the first."""
 
     _strategy = None
@@ -59,7 +59,7 @@ class _ColliderEngine(wrapper.PyRunner):
 
     def _updateCommand(self):
         args = ''.join(', %s=%r' % (name, self._params[name]) for name in self._names)
-        self.command = '%s%r%s)' % (COLLIDER_COMMAND, self._strategy, args)
+        self._setYade('command', '%s%r%s)' % (COLLIDER_COMMAND, self._strategy, args))
 
 
 class DESSCollider(_ColliderEngine):

@@ -14,7 +14,9 @@ from ._yade import O, wrapper
 from . import _core
 from . import guards as _guards
 from . import scene as _scene
-from .params import Parameter, RULES, SETTINGS, initEngine, parameterLine
+from .hooks import USER_DT_TAG, writeDt
+from .state import tag
+from .params import Engine, Parameter, RULES, SETTINGS, initEngine, parameterLine
 
 
 _INTEGRATOR_DOC = """Shi's implicit DDA time integration of all DDA blocks, with their contacts
@@ -50,7 +52,7 @@ _INTEGRATOR_DOC = """Shi's implicit DDA time integration of all DDA blocks, with
                                for row in SETTINGS))
 
 
-class DDAIntegrator(wrapper.PyRunner):
+class DDAIntegrator(Engine, wrapper.PyRunner):
     __doc__ = _INTEGRATOR_DOC
     _names = tuple(row['name'] for row in SETTINGS)
 
@@ -63,11 +65,22 @@ class DDAIntegrator(wrapper.PyRunner):
         return {name: cls.__dict__[name].default for name in cls._names}
 
     def _updateCommand(self):
-        # Parameters that differ from the defaults travel as one string literal,
-        # parsed once per distinct string (see _parse) and cached.
-        defaults = self._defaults()
-        changed = {k: v for k, v in self._params.items() if v != defaults[k]}
-        self.command = 'import yade_dda.engines as _dda; _dda.integratorStep(%r)' % (repr(changed),)
+        self._setYade('command', _command(self._params))
+
+
+_COMMAND = 'import yade_dda.engines as _dda; _dda.integratorStep(%r)'
+
+
+def _text(params):
+    """The parameters that differ from the defaults, as the text integratorStep receives: one string
+    literal in the command, parsed once per distinct string (see _parse) and cached."""
+    defaults = DDAIntegrator._defaults()
+    return repr({k: v for k, v in params.items() if v != defaults[k]})
+
+
+def _command(params):
+    """DDAIntegrator's command for its parameters."""
+    return _COMMAND % (_text(params),)
 
 
 for _row in SETTINGS:
@@ -146,9 +159,27 @@ def _checkEngines(scene, engines):
                         % (bodyId, body.groupMask, engine.mask))
 
 
+def _takeUserDt(text):
+    """The parameter text with ``dt`` set to the time step the script assigned to O.dt
+    (hooks.USER_DT_TAG), written into the engine that runs `text`; the tag is cleared."""
+    value = float(tag(USER_DT_TAG))
+    O.tags[USER_DT_TAG] = ''
+    params = dict(_parse(text)[0], dt=value)
+    for engine in O.engines:
+        if isinstance(engine, wrapper.PyRunner) and engine.command == _COMMAND % (text,):
+            if isinstance(engine, DDAIntegrator):
+                engine.dt = value
+            else:   # an engine back from O.load is a plain PyRunner with our command
+                engine.command = _command(params)
+            break
+    return _text(params)
+
+
 def integratorStep(text):
     """One DDA step; called by DDAIntegrator's command every iteration with its parameters."""
     start = time.perf_counter()
+    if tag(USER_DT_TAG):
+        text = _takeUserDt(text)
     params, settings = _parse(text)
     scene = _scene.current()
     before = len(scene.bodyOfBlock)
@@ -171,7 +202,52 @@ def integratorStep(text):
     if collider == 'MSC' and getattr(scene, 'cover', None) != cover:
         scene.core.setCover(float(cover[0]), int(cover[1]))
         scene.cover = cover
-    O.dt = scene.core.step(settings)
+    writeDt(scene.core.step(settings))
     if _syncNeeded(params, engines):
         scene.sync()
     scene.stepTimeTotal += time.perf_counter() - start
+    period = params['progressPeriod']
+    if period != 0:
+        _progress(scene, period if period > 0 else AUTO_PROGRESS_PERIOD if sys.stdout.isatty() else 0)
+
+
+AUTO_PROGRESS_PERIOD = 30.0
+"""Wall seconds between progress lines when ``progressPeriod`` < 0 and stdout is a terminal."""
+
+
+def _progress(scene, period):
+    """Prints one progress line every `period` wall seconds of a run (DDAIntegrator.progressPeriod):
+    steps/s and simulated seconds per wall second since the last line, O.time, dt, closed contacts, and
+    an ETA from O.stopAtIter (O.run(n)) or else O.stopAtTime."""
+    if period <= 0:
+        return
+    now = time.perf_counter()
+    last = getattr(scene, 'progressMark', None)
+    if last is None or O.iter < last[1]:
+        scene.progressMark = (now, O.iter, O.time)
+        return
+    wall, iteration, simulated = last
+    if now - wall < period:
+        return
+    scene.progressMark = (now, O.iter, O.time)
+    stepsPerSecond = (O.iter - iteration) / (now - wall)
+    timeRate = (O.time - simulated) / (now - wall)
+    eta = ''
+    if O.stopAtIter > O.iter and stepsPerSecond > 0:
+        eta = ', ETA %s (O.stopAtIter %d)' % (_duration((O.stopAtIter - O.iter) / stepsPerSecond), O.stopAtIter)
+    elif O.stopAtTime > O.time and timeRate > 0:
+        eta = ', ETA %s (O.stopAtTime %g s)' % (_duration((O.stopAtTime - O.time) / timeRate), O.stopAtTime)
+    counts = scene.core.lastStep()
+    print('yade_dda: iter %d, %.1f steps/s, O.time %.6g s (%.3g s per wall s), dt %.3g s, %d closed contacts in '
+          '%d pairs%s' % (O.iter, stepsPerSecond, O.time, timeRate, O.dt, counts['closedContacts'],
+                          counts['contactPairs'], eta), flush=True)
+
+
+def _duration(seconds):
+    """'2 h 05 min', '3 min 20 s' or '45 s'."""
+    seconds = int(round(seconds))
+    if seconds >= 3600:
+        return '%d h %02d min' % (seconds // 3600, seconds % 3600 // 60)
+    if seconds >= 60:
+        return '%d min %02d s' % (seconds // 60, seconds % 60)
+    return '%d s' % seconds

@@ -5,9 +5,13 @@ block. Two of YADE's classes are wrapped so that what a script does to the
 YADE scene reaches the core too; each wrapper calls YADE's original method
 (kept as the wrapper's ``_yadeDDA`` attribute) and adds the DDA part.
 """
+import os
+import tempfile
+
 from ._yade import O, wrapper
 from . import saveload as _saveload
 from . import scene as _scene
+from .params import finite
 
 _OMEGA_SAVES = ('save', 'saveTmp')
 _OMEGA_LOADS = ('load', 'loadTmp', 'reload')
@@ -62,28 +66,137 @@ def _wrapReplace(original):
 
 # ------------------------------------------------------------------ Omega
 
+def _checkSavePath(path):
+    """Refuses, before YADE writes anything, a file name that YADE would silently not write."""
+    if not isinstance(path, str) or not path:
+        raise TypeError('O.save needs a file name, got %r' % (path,))
+    directory = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(directory):
+        raise FileNotFoundError('O.save(%r): the directory %r does not exist; nothing was saved' % (path, directory))
+    if os.path.isdir(path):
+        raise IsADirectoryError('O.save(%r): is a directory; nothing was saved' % (path,))
+    if not os.access(directory, os.W_OK) or (os.path.exists(path) and not os.access(path, os.W_OK)):
+        raise PermissionError('O.save(%r): not writable; nothing was saved' % (path,))
+
+
 def _wrapSave(original):
+    toFile = original.__name__ == 'save'
+
     def save(self, *args, **kwargs):
+        if toFile:
+            _checkSavePath(args[0] if args else kwargs.get('file'))
         stored = _saveload.storeState()
         try:
-            return original(self, *args, **kwargs)
+            result = original(self, *args, **kwargs)
         finally:
             if stored:
                 O.tags[_saveload.STATE_TAG] = ''
-    save.__doc__ = original.__doc__ + '\n\n(yade_dda: also saves the DDA state, see yade_dda.saveload.)'
+        if toFile:
+            path = args[0] if args else kwargs.get('file')
+            if not os.path.isfile(path) or os.path.getsize(path) == 0:
+                raise OSError('O.save(%r): YADE wrote nothing' % (path,))
+        return result
+    save.__doc__ = original.__doc__ + \
+        '\n\n(yade_dda: also saves the DDA state, see yade_dda.saveload; a path that cannot be written raises.)'
     save._yadeDDA = original
     return save
 
 
+def _checkLoadPath(path):
+    if not isinstance(path, str) or not path:
+        raise TypeError('O.load needs a file name, got %r%s' % (
+            path, ' (yade_dda.latestCheckpoint(..., missingOk=True) found no checkpoint?)' if path is None else ''))
+    if not os.path.isfile(path):
+        raise FileNotFoundError('O.load(%r): no such file; the running scene is unchanged' % (path,))
+
+
 def _wrapLoad(original):
+    fromFile = original.__name__ == 'load'
+
     def load(self, *args, **kwargs):
+        if fromFile:
+            _checkLoadPath(args[0] if args else kwargs.get('file'))
         before = _saveload.currentToken()
-        result = original(self, *args, **kwargs)
-        _saveload.afterLoad(before)
+        # YADE empties the running scene when a load fails half-way: keep a copy to put back.
+        keep = _keepScene(self)
+        try:
+            result = original(self, *args, **kwargs)
+            _saveload.afterLoad(before)
+        except Exception as error:
+            if keep is None:
+                raise
+            _restoreScene(self, keep)
+            try:
+                annotated = type(error)('%s; the running scene was put back as it was' % (error,))
+            except Exception:   # an exception type that takes other arguments: raise it as it is
+                raise error from None
+            raise annotated from error
+        finally:
+            if keep is not None:
+                os.remove(keep)
         return result
-    load.__doc__ = original.__doc__ + '\n\n(yade_dda: also restores the DDA state, see yade_dda.saveload.)'
+    load.__doc__ = original.__doc__ + \
+        '\n\n(yade_dda: also restores the DDA state, see yade_dda.saveload; a load that fails leaves the running ' \
+        'scene as it was.)'
     load._yadeDDA = original
     return load
+
+
+def _keepScene(omega):
+    """A temporary file holding the running scene (YADE and DDA state), or None when it has no bodies."""
+    if len(omega.bodies) == 0:
+        return None
+    handle, path = tempfile.mkstemp(prefix='yade_dda-before-load-', suffix='.yade.gz')
+    os.close(handle)
+    try:
+        omega.save(path, True)
+    except BaseException:
+        os.remove(path)
+        raise
+    return path
+
+
+def _restoreScene(omega, path):
+    """Puts back the scene _keepScene saved (the DDA state with it), as it was before the failed load."""
+    before = _saveload.currentToken()
+    _original(wrapper.Omega, 'load')(omega, path, True)
+    _saveload.afterLoad(before)
+
+
+# ------------------------------------------------------------------ Omega.dt
+
+USER_DT_TAG = 'yade_dda.userDt'
+"""O.tags entry holding a time step the script assigned to O.dt, until the integrator's next step takes it."""
+
+
+class _DtProperty(property):
+    """Omega.dt with the assignment noted for the DDA integrator; ``yadeOriginal`` is YADE's property."""
+    yadeOriginal = None
+
+
+def _yadeDt():
+    current = wrapper.Omega.__dict__['dt']
+    return getattr(current, 'yadeOriginal', None) or current
+
+
+def writeDt(value):
+    """Sets O.dt as the integrator does after its step, through YADE's own setter (not a script's assignment)."""
+    _yadeDt().fset(O, value)
+
+
+def _wrapDt(original):
+    def assign(self, value):
+        # Noted in every scene (a script may set O.dt before its first block); checked where DDA
+        # blocks exist, elsewhere YADE's own rules hold (the integrator checks it when it takes it).
+        if _scene.current(create=False) is not None:
+            value = finite('O.dt', value, 0, lowOpen=True, unit=' s')
+        original.fset(self, value)
+        O.tags[USER_DT_TAG] = repr(float(value))
+    dt = _DtProperty(original.fget, assign, None, (original.__doc__ or '') + (
+        '\n\n(yade_dda: with a DDAIntegrator, a time step assigned here becomes its dt, the largest step, from the '
+        'next step on; it must be finite and > 0.)'))
+    dt.yadeOriginal = original
+    return dt
 
 
 def installHooks():
@@ -94,7 +207,7 @@ def installHooks():
 
     - ``BodyContainer.erase`` (``O.bodies.erase``): refuses to erase a DDA
       block that has entered the core (the core cannot remove blocks from a
-      running scene yet) and forgets a pending one (README, "Bad input").
+      running scene yet) and forgets a pending one (doc/user-guide.md, "Bad input").
     - ``BodyContainer.clear`` and ``replace``: give the YADE scene a fresh,
       empty DDA scene that keeps the pending blocks among the new bodies and
       those made by ``ddaBlock()`` but not yet appended (scene.freshScene).
@@ -103,7 +216,14 @@ def installHooks():
       file format carries it (saveload.storeState).
     - ``Omega.load``, ``loadTmp`` and ``reload``: after YADE reads a scene,
       drop the stale DDA scenes and rebuild the loaded one from that tag
-      (saveload.afterLoad).
+      (saveload.afterLoad); a load that fails puts the running scene back.
+      ``Omega.save`` refuses a path it cannot write; ``Omega.load`` a name
+      that is no file.
+    - ``Omega.dt``: a time step the script assigns is noted in ``O.tags``
+      (USER_DT_TAG), and checked (finite, > 0) in a scene with DDA blocks;
+      the integrator's next step makes it ``DDAIntegrator.dt``, its largest
+      step (engines.integratorStep). The integrator's own writes go through
+      YADE's setter (writeDt).
     """
     for cls, names, wrap in ((wrapper.BodyContainer, ('erase',), _wrapErase),
                              (wrapper.BodyContainer, ('clear',), _wrapClear),
@@ -112,3 +232,4 @@ def installHooks():
                              (wrapper.Omega, _OMEGA_LOADS, _wrapLoad)):
         for name in names:
             setattr(cls, name, wrap(_original(cls, name)))
+    wrapper.Omega.dt = _wrapDt(_yadeDt())

@@ -9,7 +9,9 @@ parameter from pkg/dda/solver/Settings.def; ``COLLIDERS``: the broad phases of
 this build). It imports only the compiled core, so every other module of the
 package may import it (doc/DESIGN.md, "The Python package").
 """
+import difflib
 import math
+import os
 
 from . import _core
 
@@ -57,7 +59,8 @@ INT_MAX = 2 ** 31 - 1   # the core's counters are C ints
 def integer(name, low, high=INT_MAX, bounds=None):
     """Validator of an integer parameter in [low, high]; rejects 1.5, '3', True."""
     def check(value):
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or value != int(value):
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
+                or value != int(value):
             raise TypeError('%s must be an integer, got %r' % (name, value))
         if not low <= value <= high:
             raise ValueError('%s must be an integer in %s, got %r' % (name, bounds or '[%d, %d]' % (low, high), value))
@@ -74,9 +77,28 @@ def choice(name, choices):
     return check
 
 
+PROCESSORS = os.cpu_count() or 1
+"""Processors of this machine: the most worker threads a step may ask for."""
+
+
+def _threads(check):
+    def checkThreads(value):
+        value = check(value)
+        if value > PROCESSORS:
+            raise ValueError('threads must be at most the %d processors of this machine (0 = all), got %d'
+                             % (PROCESSORS, value))
+        return value
+    return checkThreads
+
+
 def checkOf(row):
     """The validator of a row of _core.settingsTable(), by its kind; the range and its
-    text come from the row."""
+    text come from the row (``threads`` is also bounded by this machine's processors)."""
+    check = _checkOfKind(row)
+    return _threads(check) if row['name'] == 'threads' else check
+
+
+def _checkOfKind(row):
     name, kind = row['name'], row['kind']
     if kind == 'real':
         unit = '' if row['unit'] in ('', '-') else ' ' + row['unit']
@@ -119,6 +141,48 @@ class Parameter:
         engine._updateCommand()
 
 
+_PERIODS = ('iterPeriod', 'virtPeriod', 'realPeriod', 'nDo')
+
+
+class Engine:
+    """What every yade_dda engine (a ``PyRunner`` subclass) adds to YADE's
+    attributes: assigning a name that is neither one of its parameters nor an
+    attribute of YADE's engine raises AttributeError with the nearest names
+    (``dda.gravty = ...`` is a typo, not a new attribute), and its periods are
+    checked by ``_checkPeriod``.
+
+    By default an engine must run at every iteration (iterPeriod 1, no
+    virtPeriod, realPeriod or nDo): the integrator advances the blocks by the
+    step it takes, while YADE advances ``O.time`` by ``O.dt`` at every
+    iteration whether the engine ran or not, so ``iterPeriod = 2`` would let
+    ``O.time`` run ahead of the blocks; a collider engine's choice holds for
+    the iteration it ran in only."""
+
+    def __setattr__(self, name, value):
+        cls = type(self)
+        if not name.startswith('_') and name not in cls._names:
+            if not hasattr(cls, name):
+                known = sorted(set(cls._names) | {n for n in dir(cls) if not n.startswith('_')})
+                near = difflib.get_close_matches(name, known, 3)
+                raise AttributeError('%s has no parameter or attribute %r%s (its parameters: %s)' % (
+                    cls.__name__, name, '; did you mean %s?' % ' or '.join(map(repr, near)) if near else '',
+                    ', '.join(cls._names) or 'none but label'))
+            if name in _PERIODS:
+                self._checkPeriod(name, value)
+        super().__setattr__(name, value)
+
+    def _checkPeriod(self, name, value):
+        if value != {'iterPeriod': 1, 'nDo': -1}.get(name, 0):
+            raise ValueError(
+                '%s runs at every iteration: %s = %r would let O.time advance by O.dt at iterations where it '
+                'does not run (iterPeriod must be 1, virtPeriod and realPeriod 0, nDo -1); set dead = True '
+                'to stop it' % (type(self).__name__, name, value))
+
+    def _setYade(self, name, value):
+        """Sets YADE's engine attribute `name` without the checks (the engine's own bookkeeping)."""
+        super().__setattr__(name, value)
+
+
 def initEngine(engine, label, params):
     """Checks and stores an engine's typed parameters (its class's ``_names``,
     each a Parameter), runs it every step from the first, sets the label and
@@ -126,8 +190,10 @@ def initEngine(engine, label, params):
     names = type(engine)._names
     unknown = set(params) - set(names)
     if unknown:
-        raise TypeError('%s has no parameter %s%s' % (
+        near = sorted({m for name in unknown for m in difflib.get_close_matches(name, names, 2)})
+        raise TypeError('%s has no parameter %s%s%s' % (
             type(engine).__name__, ', '.join(sorted(unknown)),
+            ' (did you mean %s?)' % ', '.join(near) if near else '',
             ' (parameters: %s)' % ', '.join(names) if names else ' (it takes none but label)'))
     engine._params = {}
     for name in names:
@@ -135,8 +201,8 @@ def initEngine(engine, label, params):
         engine._params[name] = descriptor.check(params.get(name, descriptor.default))
     if not isinstance(label, str):
         raise TypeError('label must be a string, got %r' % (label,))
-    engine.iterPeriod = 1
-    engine.initRun = True
+    engine._setYade('iterPeriod', 1)
+    engine._setYade('initRun', True)
     if label:
         engine.label = label
     engine._updateCommand()

@@ -36,7 +36,7 @@ import warnings
 
 from ._yade import O, wrapper
 from . import scene as _scene
-from .params import Parameter, finite, initEngine
+from .params import Engine, Parameter, initEngine, integer
 from .scene import restoreState
 from .state import FORMAT, STATE_TAG, decodeState, encodeState, tag  # noqa: F401  (part of saveload's API)
 
@@ -110,13 +110,22 @@ def checkpoints(directory, name='checkpoint'):
     return sorted(found)
 
 
-def latestCheckpoint(directory, name='checkpoint'):
-    """Path of the newest complete checkpoint in ``directory``, or None. Resume with::
+def latestCheckpoint(directory, name='checkpoint', missingOk=False):
+    """Path of the newest complete checkpoint in ``directory`` written under
+    ``name``. With none there, FileNotFoundError naming the directory and the
+    file names looked for, or None with ``missingOk=True`` (a script that
+    resumes when it can and starts afresh otherwise). Resume with::
 
         O.load(yade_dda.latestCheckpoint('checkpoints')); O.run()
     """
     found = checkpoints(directory, name)
-    return found[-1][1] if found else None
+    if found:
+        return found[-1][1]
+    if missingOk:
+        return None
+    raise FileNotFoundError('no checkpoint %s-<iteration><format> in %r (%s)' % (
+        name, directory,
+        'the directory does not exist' if not os.path.isdir(directory) else 'nothing saved there yet'))
 
 
 def writeCheckpoint(directory, name='checkpoint', keep=3, format='.yade.gz'):
@@ -176,7 +185,7 @@ def _checkFormat(value):
     return value
 
 
-class Checkpoint(wrapper.PyRunner):
+class Checkpoint(Engine, wrapper.PyRunner):
     """Saves the whole scene (YADE's and the DDA state) every ``period``
     iterations, crash-safe, keeping the newest ``keep`` files.
 
@@ -196,10 +205,10 @@ class Checkpoint(wrapper.PyRunner):
         O.engines = [DDAIntegrator(dt=1e-3), Checkpoint(period=10000, directory='checkpoints')]
     """
 
-    period = Parameter(1000, lambda v: int(finite('period', v, 1)), 'iterations between checkpoints')
+    period = Parameter(1000, integer('period', 1), 'iterations between checkpoints')
     directory = Parameter('checkpoints', _checkString('directory'), 'directory of the checkpoint files')
     name = Parameter('checkpoint', _checkString('name'), 'file name stem')
-    keep = Parameter(3, lambda v: int(finite('keep', v, 1)), 'checkpoints kept')
+    keep = Parameter(3, integer('keep', 1), 'checkpoints kept')
     format = Parameter('.yade.gz', _checkFormat, 'file format by extension')
 
     _names = ('period', 'directory', 'name', 'keep', 'format')
@@ -207,10 +216,16 @@ class Checkpoint(wrapper.PyRunner):
     def __init__(self, label='', **params):
         wrapper.PyRunner.__init__(self)
         initEngine(self, label, params)
-        self.initRun = False
+        self._setYade('initRun', False)
+
+    def _checkPeriod(self, name, value):
+        # iterPeriod is `period`'s; virtPeriod and realPeriod are YADE's own (a checkpoint every
+        # hour of wall time: realPeriod=3600), nDo too.
+        if name == 'iterPeriod' and value != self.period:
+            raise ValueError('Checkpoint: set period (iterations between checkpoints), not iterPeriod; got %r' % value)
 
     def _updateCommand(self):
         params = dict(self._params)
-        self.iterPeriod = params.pop('period')
-        self.command = ('import yade_dda.saveload as _ddaSave; _ddaSave.writeCheckpoint(%r, %r, %r, %r)'
-                        % (params['directory'], params['name'], params['keep'], params['format']))
+        self._setYade('iterPeriod', params.pop('period'))
+        self._setYade('command', ('import yade_dda.saveload as _ddaSave; _ddaSave.writeCheckpoint(%r, %r, %r, %r)'
+                        % (params['directory'], params['name'], params['keep'], params['format'])))

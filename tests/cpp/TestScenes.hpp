@@ -1,7 +1,7 @@
-// Scene builders shared by the C++ tests (test_colliders.cpp, test_msc.cpp,
-// test_block_kinematics.cpp, ...): axis-aligned and oriented boxes and a random scene of slender and compact,
-// turned, fixed and free blocks with a few exact placements; and the contact
-// set a broad phase plus the narrow phase find.
+// Scene builders shared by the C++ tests (tests/cpp/<layer>/*.cpp): axis-aligned and
+// oriented boxes, random unknowns, a random scene of slender and compact, turned, fixed
+// and free blocks with a few exact placements, a settling pile of cubes with its
+// gravity settings; and the contact set a broad phase plus the narrow phase find.
 #pragma once
 
 #include "dda/collider/Collider.hpp"
@@ -13,6 +13,8 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <cmath>
+#include <memory>
 #include <random>
 #include <set>
 #include <tuple>
@@ -43,6 +45,14 @@ inline Eigen::Matrix3d randomRotation(std::mt19937& rng) {
 	return Eigen::AngleAxisd(3.2 * unit(rng), axis).toRotationMatrix();
 }
 
+// 12 unknowns drawn uniformly from [-1, 1].
+inline Vector12 randomUnknowns(std::mt19937& rng) {
+	std::uniform_real_distribution<double> u(-1, 1);
+	Vector12 D;
+	for (int i = 0; i < 12; ++i) D(i) = u(rng);
+	return D;
+}
+
 // n blocks: slender (up to 15:1, 15 m long) and compact boxes, randomly
 // turned, in a 25 m cube so that many touch or nearly touch; about 30% fixed;
 // then unit cubes exactly corner on corner and edge on edge.
@@ -70,6 +80,40 @@ inline std::vector<Block> blocksOf(const World& world) {
 	std::vector<Block> blocks;
 	for (int i = 0; i < world.blockCount(); ++i) blocks.push_back(world.block(i));
 	return blocks;
+}
+
+// A fixed floor and 2 x 2 x `layers` unit cubes, slightly turned, 5 cm
+// apart, dropped from a few cm; optionally one more cube `dropHeight` [m]
+// above the pile (it arrives while the pile rests).
+inline World cubePile(std::unique_ptr<Collider> collider, int layers, double dropHeight, double frictionDeg = 30) {
+	const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+	World world;
+	world.setCollider(std::move(collider));
+	Material rock;
+	rock.frictionAngle = frictionDeg * M_PI / 180;
+	world.addBlock(orientedBox(Vector3(0, 0, -0.5), Vector3(3, 3, 0.5), I), rock, true);
+	std::mt19937 rng(7);
+	std::uniform_real_distribution<double> tilt(-0.03, 0.03);
+	for (int layer = 0; layer < layers; ++layer)
+		for (int k = 0; k < 4; ++k) {
+			const Eigen::Matrix3d R = Eigen::AngleAxisd(tilt(rng), Vector3::UnitZ()).toRotationMatrix() *
+			                          Eigen::AngleAxisd(tilt(rng), Vector3::UnitX()).toRotationMatrix();
+			const Vector3 centre(-0.55 + 1.1 * (k % 2), -0.55 + 1.1 * (k / 2), 0.55 + 1.08 * layer);
+			world.addBlock(orientedBox(centre, Vector3(0.5, 0.5, 0.5), R), rock, false);
+		}
+	if (dropHeight > 0)
+		world.addBlock(orientedBox(Vector3(-0.3, -0.2, 0.55 + 1.08 * layers + dropHeight), Vector3(0.5, 0.5, 0.5), I),
+		               rock, false);
+	return world;
+}
+
+// Gravity, 2 ms steps, and DESS's candidate-pair cache on or off.
+inline IntegratorSettings gravitySettings(bool reuse) {
+	IntegratorSettings settings;
+	settings.gravity = Vector3(0, 0, -9.81);
+	settings.maxTimeStep = 2e-3;
+	settings.reuseCandidatePairs = reuse;
+	return settings;
 }
 
 // What a broad phase and the narrow phase find: per pair within d0 its

@@ -27,7 +27,8 @@ and exits non-zero when the baseline fails or a mutation is not caught.
 
 Run: /usr/bin/python3 tests/mutations/run.py [--only NAME ...] [--build-dir DIR]
 (`make mutations`). Not part of `make test`: it builds the module once per
-mutation.
+mutation. `--list` builds nothing: it prints each mutation's tests and checks
+that pytest collects every one of them in this checkout (exit 1 if not).
 """
 import argparse
 import filecmp
@@ -182,6 +183,30 @@ def run_tests(src, tree, nodeids, xml, log, timeout):
     return out
 
 
+def collected(nodeids):
+    """The subset of `nodeids` that `pytest --collect-only` finds in this checkout (slow cases
+    included), with the yade_dda that YADE_DDA_BUILD or the installed package gives."""
+    cmd = [PYTHON, '-m', 'pytest', '--collect-only', '-q', '-p', 'no:cacheprovider', '-m', 'slow or not slow'] \
+        + sorted({n.split('::', 1)[0] for n in nodeids})
+    out = subprocess.run(cmd, cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True).stdout
+    found = {line.strip() for line in out.splitlines()}
+    return {n for n in nodeids if n in found}
+
+
+def list_mutations(chosen):
+    """Prints each mutation's tests, marking those pytest does not collect; True when all are."""
+    nodeids = {t for m in chosen for t in m['tests']}
+    found = collected(nodeids)
+    for m in chosen:
+        print('%s: %s' % (m['name'], m['removes']))
+        for t in m['tests']:
+            print('  %s%s' % (t, '' if t in found else '   <- NOT COLLECTED'))
+    missing = len(nodeids - found)
+    print('\n%d tests named by %d mutations; %s' % (
+        len(nodeids), len(chosen), 'all collected' if not missing else '%d NOT collected' % missing))
+    return not missing
+
+
 def first_line(message, width=None):
     """The assertion's first line, with pytest's `assert ...` line after a custom message."""
     lines = message.strip().splitlines() or ['']
@@ -205,6 +230,8 @@ def main():
     parser.add_argument('--out', default=os.path.join(REPO, 'bench', 'out', 'mutations.json'))
     parser.add_argument('--jobs', type=int, default=int(os.environ.get('JOBS', 2)))
     parser.add_argument('--timeout', type=int, default=3600, help='seconds per pytest run')
+    parser.add_argument('--list', action='store_true',
+                        help='build and run nothing: print the tests of each mutation and check that pytest collects them')
     args = parser.parse_args()
 
     chosen = mutations()
@@ -214,6 +241,8 @@ def main():
             raise SystemExit('no mutation named %s (have: %s)' % (', '.join(sorted(unknown)),
                                                                   ', '.join(m['name'] for m in chosen)))
         chosen = [m for m in chosen if m['name'] in args.only]
+    if args.list:
+        sys.exit(0 if list_mutations(chosen) else 1)
     top = os.path.abspath(args.build_dir)
     src, tree, logs = (os.path.join(top, d) for d in ('src', 'build', 'logs'))
     for d in (src, tree, logs):

@@ -3,7 +3,7 @@ scene must satisfy, checked after every step.
 
 - finite: every block's vertices, 12 rates, stress and strain are finite;
 - penetration: no two blocks overlap by more than the documented tolerance
-  (README, "Penetration tolerance"), measured two ways: the core's deepest
+  (doc/testing.md, "Penetration tolerance"), measured two ways: the core's deepest
   closed contact (stats()['maxPenetration'], the linearised gap at the end of
   the step) and the true overlap of the blocks' current shapes, computed here
   independently of the core's narrow phase (separating axes over all face
@@ -179,7 +179,7 @@ class Guard:
         return (total, dict(kinetic=kinetic, gravity=gravity, strain=strain, springs=springs)) if parts else total
 
     def penetration(self):
-        """The documented penetration tolerance (README, "Penetration tolerance") [m]:
+        """The documented penetration tolerance (doc/testing.md, "Penetration tolerance") [m]:
 
             d_tol = 2 W / kn + sqrt(2 K / kn) + 1e-6 L   (+ extraPenetration)
 

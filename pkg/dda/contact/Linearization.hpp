@@ -40,7 +40,7 @@
 // derivative has the extra term -sigma Delta0 dS / S^2 = -d0 dS / S, first
 // order in the rotation and strain of the face or edges and proportional to
 // the gap d0; DDA drops it, so penalty springs act along the start-of-step
-// normal (tests/cpp/test_contact_geometry.cpp checks that the difference is
+// normal (tests/cpp/contact/test_contact_geometry.cpp checks that the difference is
 // exactly this term).
 #pragma once
 

@@ -25,7 +25,7 @@ constexpr double kSameNormalCosine = 0.9;
 // crossing whose line distance is deeper than PD is an edge piercing a face
 // steeply near its boundary, or passing another edge beyond the face's plane.
 // Before, a crossing could be twice the entrance's penetration deep (the
-// narrow-phase oracle, tests/cpp/test_narrow_phase_oracle.cpp, found
+// narrow-phase oracle, tests/cpp/contact/test_narrow_phase_oracle.cpp, found
 // crossings between 1 and 2 x PD deep in ~1.8% of random near pairs of
 // slender blocks), and once d0 deeper (crossings 9 mm deep between blocks
 // 0.3 to 4 mm apart).
@@ -460,7 +460,7 @@ void tiedFaceContacts(const Prepared& a, const Prepared& b, const std::vector<Fa
 // contact of two such edges is the vertex contacts at their ends, measured
 // along the entrance face's normal, which lie deeper than the overlap
 // across the edges (a bar resting edge on edge 1e-4 rad from parallel
-// sank 0.13 mm into the other, tests/py/test_hard_cases.py, when its
+// sank 0.13 mm into the other, tests/py/system/test_hard_cases.py, when its
 // corners were bound by it).
 void findSubContacts(const Prepared& a, const Prepared& b, const std::vector<FaceCandidate>& faces,
                      const AxisSearch& axes, const EntranceFeature& previous, const DetectionSettings& settings,

@@ -583,6 +583,53 @@ ConvexPolyhedron buildConvexPolyhedron(const std::vector<Vector3>& points) {
 	return poly;
 }
 
+std::vector<int> hullCorners(const std::vector<Vector3>& points) {
+	requireEnoughPoints(points);
+	requireFiniteCoordinates(points);
+	// Points closer than the coincidence tolerance are one: the first of them stays.
+	const double coincidence = kCoincidenceRelativeTolerance * boundingBoxDiagonal(points);
+	std::vector<int> kept;
+	for (int i = 0; i < static_cast<int>(points.size()); ++i) {
+		const bool repeated = std::any_of(kept.begin(), kept.end(), [&](int k) {
+			return points[k] == points[i] || (points[k] - points[i]).norm() < coincidence;
+		});
+		if (!repeated) kept.push_back(i);
+	}
+	const auto pick = [&points](const std::vector<int>& indices) {
+		std::vector<Vector3> picked;
+		picked.reserve(indices.size());
+		for (int i : indices) picked.push_back(points[i]);
+		return picked;
+	};
+	if (kept.size() < 4) requireEnoughPoints(pick(kept));
+	requireVolume(pick(kept));
+	// Each round drops what the exact hull leaves inside, then what lies on a
+	// merged face without being a corner of it (on the boundary of fewer than
+	// kMinFacetsAtCorner merged faces: inside a face or an edge within the
+	// coplanar tolerance). Dropping a point can merge faces anew (and the
+	// tolerance follows the shrinking bounding box), so rounds repeat until
+	// none drops a point; each drops at least one, so there are fewer rounds
+	// than points.
+	for (;;) {
+		const std::vector<Vector3> candidates = pick(kept);
+		const std::vector<Triangle> triangles = hullTriangles(candidates);
+		std::vector<int> facetCount(candidates.size(), 0);
+		std::vector<bool> onHull(candidates.size(), false);
+		for (const Triangle& t : triangles)
+			for (int v : t) onHull[v] = true;
+		const double tolerance = kCoplanarRelativeTolerance * boundingBoxDiagonal(candidates);
+		const Facets facets = growFacets(candidates, triangles, tolerance);
+		for (const std::vector<int>& cycle : facetBoundaries(triangles, facets))
+			for (int v : cycle) ++facetCount[v];
+		std::vector<int> corners;
+		for (std::size_t i = 0; i < candidates.size(); ++i)
+			if (onHull[i] && facetCount[i] >= kMinFacetsAtCorner) corners.push_back(kept[i]);
+		if (corners.size() == kept.size()) return kept;
+		if (corners.size() < 4) requireEnoughPoints(pick(corners));
+		kept = std::move(corners);
+	}
+}
+
 std::shared_ptr<const PolyhedronTopology> TopologyPool::intern(std::shared_ptr<const PolyhedronTopology> topology) {
 	std::size_t hash = topology->faces.size();
 	const auto mix = [&hash](int x) { hash = hash * 1000003u ^ static_cast<std::size_t>(x); };

@@ -105,6 +105,17 @@ private:
 // never merges into one curved face.
 ConvexPolyhedron buildConvexPolyhedron(const std::vector<Vector3>& points);
 
+// The corners of the convex hull of any points [m]: indices into `points`,
+// in input order, of the points that buildConvexPolyhedron accepts as the
+// corners of that hull. Dropped: points inside the hull (decided exactly),
+// repeats (closer than the coincidence tolerance: the first stays), and
+// points on the hull surface that are no corner of its faces merged within
+// the coplanar tolerance (inside a face or an edge, or a corner so flat that
+// the faces around it merge). Those last drops change the volume by at most
+// the tolerance times the hull's area. Throws InputError for fewer than 4
+// points, NaN or inf, or no volume.
+std::vector<int> hullCorners(const std::vector<Vector3>& points);
+
 // Unit outward normal of a face by Newell's method (the polygon's vector area,
 // taken about the mean of its corners to limit round-off far from the origin).
 // Well defined for the nearly planar faces of buildConvexPolyhedron; outward

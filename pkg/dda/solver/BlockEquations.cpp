@@ -6,16 +6,33 @@
 
 namespace dda {
 
+namespace {
+// The block's own loads in its first N unknowns (N = 12, or 6 for a rigid
+// block's system) [N, N m, N m]: gravity, the fixed-point springs' pull
+// toward their anchors and the point loads; with `stiffness` given, the
+// springs' stiffness k T^T T [N/m] too. One definition for restForce and both
+// assemblies, so the rest force is the assembled force at D = 0 without
+// inertia by construction; the terms are added in one order (gravity,
+// springs, loads) everywhere.
+template <int N, typename Force, typename Stiffness>
+void addOwnLoads(const Block& block, const IntegratorSettings& settings, Force&& force, Stiffness* stiffness) {
+	if (!settings.gravity.isZero()) force.template head<3>() += block.mass * settings.gravity;
+	for (const FixedPoint& point : block.fixedPoints) {
+		const Eigen::Matrix<double, 3, N> T = displacementMatrix(point.position - block.centroid).template leftCols<N>();
+		const double k = fixedPointStiffness(point, block, settings);
+		if (stiffness) stiffness->noalias() += k * T.transpose() * T;
+		force.noalias() += k * T.transpose() * (point.anchor - point.position);
+	}
+	for (const PointLoad& load : block.loads)
+		force.noalias() +=
+		    displacementMatrix(load.position - block.centroid).template leftCols<N>().transpose() * load.force;
+}
+}  // namespace
+
 Vector12 restForce(const Block& block, const IntegratorSettings& settings) {
 	Vector12 force = Vector12::Zero();
 	if (!block.rigid) force.segment<6>(6) -= block.volume * block.stress;
-	force.head<3>() += block.mass * settings.gravity;
-	for (const FixedPoint& point : block.fixedPoints) {
-		const Matrix3x12 T = displacementMatrix(point.position - block.centroid);
-		force.noalias() += fixedPointStiffness(point, block, settings) * T.transpose() * (point.anchor - point.position);
-	}
-	for (const PointLoad& load : block.loads)
-		force.noalias() += displacementMatrix(load.position - block.centroid).transpose() * load.force;
+	addOwnLoads<12>(block, settings, force, static_cast<Matrix12*>(nullptr));
 	if (block.rigid) force.tail<6>().setZero();
 	return force;
 }
@@ -60,16 +77,7 @@ void assembleBlock(const Block& block, const IntegratorSettings& settings, doubl
 	system.stiffness.block<6, 6>(6, 6).noalias() += block.referenceVolume() * block.elasticity();
 	system.force.segment<6>(6).noalias() -= block.volume * block.stress;
 
-	if (!settings.gravity.isZero()) system.force.head<3>() += block.mass * settings.gravity;
-
-	for (const FixedPoint& point : block.fixedPoints) {
-		const Matrix3x12 T = displacementMatrix(point.position - block.centroid);
-		const double stiffness = fixedPointStiffness(point, block, settings);
-		system.stiffness.noalias() += stiffness * T.transpose() * T;
-		system.force.noalias() += stiffness * T.transpose() * (point.anchor - point.position);
-	}
-	for (const PointLoad& load : block.loads)
-		system.force.noalias() += displacementMatrix(load.position - block.centroid).transpose() * load.force;
+	addOwnLoads<12>(block, settings, system.force, &system.stiffness);
 }
 
 void assembleRigidBlock(const Block& block, const IntegratorSettings& settings, double dt, const Vector12& a0,
@@ -85,15 +93,7 @@ void assembleRigidBlock(const Block& block, const IntegratorSettings& settings, 
 	auto stiffness = system.stiffness.topLeftCorner<6, 6>();
 	auto force = system.force.head<6>();
 	addInertia(mass, v0, a06, settings, dt, stiffness, force);
-	if (!settings.gravity.isZero()) force.head<3>() += block.mass * settings.gravity;
-	for (const FixedPoint& point : block.fixedPoints) {
-		const Matrix3x6 T = displacementMatrix(point.position - block.centroid).leftCols<6>();
-		const double k = fixedPointStiffness(point, block, settings);
-		stiffness.noalias() += k * T.transpose() * T;
-		force.noalias() += k * T.transpose() * (point.anchor - point.position);
-	}
-	for (const PointLoad& load : block.loads)
-		force.noalias() += displacementMatrix(load.position - block.centroid).leftCols<6>().transpose() * load.force;
+	addOwnLoads<6>(block, settings, force, &stiffness);
 }
 
 Vector12 endVelocity(const Vector12& D, const Vector12& v0, double dt) {

@@ -29,7 +29,7 @@
 // component has no duplicate entries, so it is the same matrix, entry for
 // entry, in the same order), and the numeric factorisation runs exactly the
 // arithmetic of compute(): the solutions are bitwise those of a fresh analysis
-// (tests/cpp/test_rigid_blocks.cpp compares them). Patterns unused for
+// (tests/cpp/solver/test_rigid_blocks.cpp compares them). Patterns unused for
 // kKeptBuilds builds, or beyond the used patterns' size, are dropped.
 //
 // Rigid blocks have 6 unknowns, not 12. Every block keeps the 12-layout in

@@ -17,7 +17,7 @@
 // from the blocks of a settled run is accepted; the second term accepts
 // coordinates rounded to about a micrometre of a metre block; d0 caps it,
 // beyond which the narrow phase's sub-contacts are no longer reliable. These
-// are the first and last terms of the penetration tolerance of the README.
+// are the first and last terms of the penetration tolerance (doc/testing.md, "Penetration tolerance").
 // Fixed-fixed pairs are never checked (they never touch each other's motion).
 #pragma once
 
