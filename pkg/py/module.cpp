@@ -8,7 +8,6 @@
 // IndexError, anything else -> RuntimeError.
 #include "SceneLink.hpp"
 #include "dda/collider/ColliderFactory.hpp"
-#include "dda/collider/MSCCollider.hpp"
 #include "dda/solver/InitialOverlaps.hpp"
 
 #include <boost/python.hpp>
@@ -243,11 +242,9 @@ void setCollider(SceneLink& s, const std::string& name) {
 std::string colliderName(const SceneLink& s) { return s.world.collider().name(); }
 
 // MSC's critical length lambda [m] (0 = 3 x each block's size) and segments N
-// for the whole scene; the current collider must be MSC.
+// for the whole scene; colliders without a cover raise (Collider::setCover).
 void setCover(SceneLink& s, double criticalLength, int segments) {
-	auto* msc = dynamic_cast<MSCCollider*>(&const_cast<Collider&>(s.world.collider()));
-	if (!msc) throw InputError("the scene's collider is not MSC");
-	msc->setCover(criticalLength, segments);
+	s.world.collider().setCover(criticalLength, segments);
 }
 
 py::dict lastStep(const SceneLink& s) {
@@ -431,7 +428,7 @@ BOOST_PYTHON_MODULE(_core) {
 	        "hull, repeats and points on a face or an edge of it within the coplanar tolerance are left out); "
 	        "ValueError for fewer than 4 points, NaN or inf, or no volume.");
 
-	py::scope().attr("mscMaxSegments") = MSCCollider::kMaxSegments;
+	py::scope().attr("mscMaxSegments") = kMaxCoverSegments;
 
 	py::def("settingsTable", &settingsTable,
 	        "Every DDAIntegrator parameter, one dict per row of pkg/dda/solver/Settings.def: name, member (the "

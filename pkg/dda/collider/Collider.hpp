@@ -6,6 +6,9 @@
 // others are tested against.
 #pragma once
 
+#include "BroadPhaseStatistics.hpp"
+#include "PairCache.hpp"
+
 #include "dda/block/Block.hpp"
 #include "dda/core/CapacityBytes.hpp"
 #include "dda/geometry/SubUnits.hpp"
@@ -28,23 +31,9 @@ class StateReader;
 // half of d0 per side would miss those pairs (the collider test caught it).
 constexpr double kBroadPhaseMarginFactor = 1.0;
 
-// Counters of one findPairs call (they describe that call only).
-struct BroadPhaseStatistics {
-	long candidatePairs = 0;  // block pairs handed to the narrow phase
-	long shellPairs = 0;      // overlapping bounding-volume pairs found (MSC: shell pairs, as boxes and in frames)
-	long shellTests = 0;      // bounding-volume comparisons made (cached pairs re-checked and MSC's frame tests included)
-	long shells = 0;          // bounding volumes (DESS, NBS: one per block; AllPairs: none)
-	long shellUpdates = 0;    // bounding volumes recomputed from corners this call
-	// The narrow phase's "sub-unit loops" (Wu et al. 2014, Sec. 4.2): over the
-	// candidate pairs (a, b), Va x Fb + Vb x Fa + Ea x Eb, with V, E, F the
-	// vertices, edges and faces each block offers the pair (MSC: the linked
-	// sub-units of the overlapping shells; other strategies: all of them).
-	long subUnitPairs = 0;
-	// Candidate-pair reuse (DESS's and MSC's Verlet caches; 0 for other strategies).
-	long broadPhaseSkipped = 0;  // 1 when no sort-and-sweep was made this call (pairs from the cache)
-	long pairsReused = 0;        // cached pairs re-checked instead of searched for
-	long blocksResearched = 0;   // blocks searched against the others this call (all of them on a full search)
-};
+// Most slabs per block of a multi-shell cover (MSCCollider.hpp; its shell
+// sets are 64-bit masks) [-].
+constexpr int kMaxCoverSegments = 64;
 
 class Collider {
 public:
@@ -66,6 +55,11 @@ public:
 	// Whether the strategy may reuse candidates of earlier calls (strategies
 	// without a cache ignore it). The pairs returned never depend on it.
 	virtual void setPairReuse(bool /*reuse*/) {}
+	// The scene's multi-shell cover (MSCCollider.hpp): critical length [m]
+	// >= 0, 0 = by each block's size, and segments in [1, kMaxCoverSegments].
+	// Strategies without a cover raise InputError (the binding calls this
+	// without knowing the strategy).
+	virtual void setCover(double criticalLength, int segments);
 	// Heap bytes the strategy holds between calls (its arrays' capacities:
 	// boxes, shells, grid, caches, linked lists) [bytes], for stats().
 	virtual std::size_t memoryBytes() const { return 0; }
@@ -85,38 +79,26 @@ public:
 // there are checked on the other two axes.
 // O(n log n + pairs) per step.
 //
-// Verlet cache (on unless setPairReuse(false)): a search sweeps boxes widened
-// by D = d0 (1 + kVerletSkinFactor) and keeps every pair whose widened boxes
-// meet, and each block's tight box B_b then. A block's D-box contains its
-// d0-box of a later step as long as its tight box stays inside B_b widened by
-// D - d0 (minus a round-off slack), so while that holds for both blocks of a
-// pair whose d0-boxes meet now, the pair is in the cache. Each call therefore
-// (1) computes the tight boxes, (2) re-searches only the blocks that left
-// their allowance, against every block's D-box (a full sort-and-sweep instead
-// when more than kVerletPartialFactor x log2(n) blocks left), and (3) returns
-// the cached pairs whose d0-boxes meet now, with the same floating-point
-// test as a search without cache. The pairs returned are therefore exactly
-// those of a search without cache, in the same order; only the work differs.
-// Blocks at rest are not searched again until something moves past its
-// allowance.
+// Pair cache (PairCache.hpp, on unless setPairReuse(false)): the sweep is
+// made with boxes widened by D = d0 (1 + PairCache::kVerletSkinFactor) and
+// its pairs kept; each call re-searches only the blocks whose d0-box left
+// their D-box (a full sort-and-sweep when many did) and returns the cached
+// pairs whose d0-boxes meet now, with the same floating-point test as a
+// search without cache. The pairs returned are therefore exactly those of a
+// search without cache, in the same order; only the work differs. Blocks at
+// rest are not searched again until something moves past its allowance.
 class DESSCollider : public Collider {
 public:
-	// Skin of the Verlet cache, x d0 [-]: a block may move this far (per
-	// coordinate of its box) before it is searched again.
-	static constexpr double kVerletSkinFactor = 1.0;
-	// Blocks re-searched one by one (O(n) each) when at most this x log2(n)
-	// left their allowance; else a full sort-and-sweep.
-	static constexpr double kVerletPartialFactor = 4.0;
 	const char* name() const override { return "DESS"; }
 	void findPairs(const std::vector<Block>& blocks, double contactDistance, std::vector<std::pair<int, int>>& pairs,
 	               BroadPhaseStatistics& stats) override;
-	void setPairReuse(bool reuse) override;
+	void setPairReuse(bool reuse) override { cache_.setReuse(reuse); }
 	std::size_t memoryBytes() const override {
-		return capacityBytes(boxes_) + capacityBytes(order_) + capacityBytes(fixed_) + capacityBytes(searchedBoxes_) + capacityBytes(cached_) +
-		       capacityBytes(kept_) + capacityBytes(searchedFixed_) + capacityBytes(moved_) + capacityBytes(movers_);
+		return capacityBytes(boxes_) + capacityBytes(order_) + capacityBytes(fixed_) + cache_.memoryBytes();
 	}
 
 private:
+	struct Volumes;  // what the pair cache sees of it (DESSCollider.cpp)
 	// Sort-and-sweep of `boxes` (pairs not both fixed) into `pairs`, sorted;
 	// returns the box comparisons made.
 	long sweep(const std::vector<Block>& blocks, const std::vector<Eigen::AlignedBox3d>& boxes,
@@ -124,14 +106,7 @@ private:
 	std::vector<Eigen::AlignedBox3d> boxes_;  // this call's boxes, widened by d0
 	std::vector<int> order_;
 	std::vector<char> fixed_;  // per block, for the sweep
-	bool reuse_ = true;
-	// The cache: each block's D-box from when it was last searched, every
-	// pair (not both fixed) whose D-boxes meet, sorted, and the fixed flags.
-	bool cacheValid_ = false;
-	std::vector<Eigen::AlignedBox3d> searchedBoxes_;
-	std::vector<std::pair<int, int>> cached_, kept_;
-	std::vector<char> searchedFixed_, moved_;
-	std::vector<int> movers_;
+	PairCache cache_{PairCache::Growth::Doubling};
 };
 
 // No binary search (Munjiza & Andrews): one bounding sphere per block (centre

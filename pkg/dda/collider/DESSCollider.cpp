@@ -14,10 +14,24 @@ Eigen::AlignedBox3d widened(const Eigen::AlignedBox3d& box, double margin) {
 }
 }  // namespace
 
-void DESSCollider::setPairReuse(bool reuse) {
-	reuse_ = reuse;
-	if (!reuse) cacheValid_ = false;
-}
+// What the pair cache sees: one item per block, its box widened by d0, its
+// D-box that box widened by the skin (which contains it exactly: x - skin <=
+// x and x + skin >= x in floats, all the cache relies on), and the sweep.
+struct DESSCollider::Volumes {
+	DESSCollider& dess;
+	const std::vector<Block>& blocks;
+	double skin;
+	int count() const { return static_cast<int>(blocks.size()); }
+	int first(int block) const { return block; }
+	int end(int block) const { return block + 1; }
+	int blockOf(int item) const { return item; }
+	const Eigen::AlignedBox3d& box(int item) const { return dess.boxes_[item]; }
+	Eigen::AlignedBox3d searchBox(int item) const { return widened(dess.boxes_[item], skin); }
+	long search(const std::vector<Eigen::AlignedBox3d>& boxes, std::vector<ItemPair>& out, std::vector<ItemPair>&) {
+		return dess.sweep(blocks, boxes, out);
+	}
+	void sort(std::vector<ItemPair>& pairs, std::vector<ItemPair>&) const { std::sort(pairs.begin(), pairs.end()); }
+};
 
 long DESSCollider::sweep(const std::vector<Block>& blocks, const std::vector<Eigen::AlignedBox3d>& boxes,
                          std::vector<std::pair<int, int>>& pairs) {
@@ -57,10 +71,7 @@ void DESSCollider::findPairs(const std::vector<Block>& blocks, double contactDis
 	stats = BroadPhaseStatistics{};
 	const int n = static_cast<int>(blocks.size());
 	const double margin = kBroadPhaseMarginFactor * contactDistance;
-	// A D-box is the d0-box widened by the skin: it contains the d0-box
-	// exactly (x - skin <= x and x + skin >= x in floats), which is all the
-	// cache relies on.
-	const double skin = margin * kVerletSkinFactor;
+	const double skin = margin * PairCache::kVerletSkinFactor;
 	boxes_.resize(n);
 	for (int b = 0; b < n; ++b) {
 		Eigen::AlignedBox3d box;
@@ -69,63 +80,17 @@ void DESSCollider::findPairs(const std::vector<Block>& blocks, double contactDis
 	}
 	stats.shells = stats.shellUpdates = n;
 
-	if (!reuse_) {
-		cacheValid_ = false;
+	if (!cache_.reuse()) {
 		stats.shellTests = sweep(blocks, boxes_, pairs);
 		stats.blocksResearched = n;
 	} else {
-		// Blocks whose d0-box left the D-box of their last search. The test is
-		// on the same floats the final filter uses: boxes inside their D-boxes
-		// that meet imply D-boxes that meet, with no round-off argument needed.
-		bool full = !cacheValid_ || static_cast<int>(searchedBoxes_.size()) != n;
-		movers_.clear();
-		moved_.assign(n, 0);
-		for (int b = 0; b < n && !full; ++b) {
-			if (static_cast<char>(blocks[b].fixed) != searchedFixed_[b]) full = true;
-			else if (!searchedBoxes_[b].contains(boxes_[b])) {
-				movers_.push_back(b);
-				moved_[b] = 1;
-			}
-		}
-		const double partialLimit = kVerletPartialFactor * std::log2(std::max(2, n));
-		if (!full && static_cast<double>(movers_.size()) > partialLimit) full = true;
-		if (full) {
-			searchedBoxes_.resize(n);
-			searchedFixed_.resize(n);
-			for (int b = 0; b < n; ++b) {
-				searchedBoxes_[b] = widened(boxes_[b], skin);
-				searchedFixed_[b] = blocks[b].fixed;
-			}
-			stats.shellTests = sweep(blocks, searchedBoxes_, cached_);
-			stats.blocksResearched = n;
-			cacheValid_ = true;
-		} else {
-			stats.broadPhaseSkipped = 1;
-			stats.blocksResearched = static_cast<long>(movers_.size());
-			if (!movers_.empty()) {
-				// Each mover gets a new D-box and is compared with every block.
-				for (int m : movers_) searchedBoxes_[m] = widened(boxes_[m], skin);
-				kept_.clear();
-				for (const auto& pair : cached_)
-					if (!moved_[pair.first] && !moved_[pair.second]) kept_.push_back(pair);
-				stats.pairsReused = static_cast<long>(kept_.size());
-				for (int m : movers_)
-					for (int b = 0; b < n; ++b) {
-						if (b == m || (moved_[b] && b < m) || (blocks[b].fixed && blocks[m].fixed)) continue;
-						++stats.shellTests;
-						if (searchedBoxes_[m].intersects(searchedBoxes_[b])) kept_.emplace_back(std::min(m, b), std::max(m, b));
-					}
-				std::sort(kept_.begin(), kept_.end());
-				cached_.swap(kept_);
-			} else {
-				stats.pairsReused = static_cast<long>(cached_.size());
-			}
-		}
+		Volumes volumes{*this, blocks, skin};
+		cache_.update(volumes, blocks, stats);
 		// The pairs a search without cache returns: those whose d0-boxes meet.
 		pairs.clear();
-		for (const auto& [a, b] : cached_)
+		for (const auto& [a, b] : cache_.pairs())
 			if (boxes_[a].intersects(boxes_[b])) pairs.emplace_back(a, b);
-		stats.shellTests += static_cast<long>(cached_.size());
+		stats.shellTests += static_cast<long>(cache_.pairs().size());
 	}
 	stats.candidatePairs = stats.shellPairs = static_cast<long>(pairs.size());
 	for (auto [a, b] : pairs) stats.subUnitPairs += allSubUnitPairs(*blocks[a].shape, *blocks[b].shape);

@@ -262,6 +262,77 @@ bool CoupledSystem::solveSingleBlock(int slot, std::vector<Vector12>& solutions)
 	return llt.info() == Eigen::Success;
 }
 
+template <class Entry>
+void CoupledSystem::forEachEntry(int c, const std::vector<int>& offset, Entry&& entry) const {
+	const int first = componentStart_[c], last = componentStart_[c + 1];
+	for (int s = first; s < last; ++s) {
+		const int base = offset[s - first], size = unknowns_[s];
+		for (int col = 0; col < size; ++col)
+			for (int row = col; row < size; ++row) entry(base + row, base + col, diagonal_[s](row, col));
+	}
+	for (int link = linkStart_[c]; link < linkStart_[c + 1]; ++link) {
+		const auto [lo, hi] = linkSlots_[link];
+		const int rowBase = offset[hi - first], colBase = offset[lo - first];
+		const int rows = unknowns_[hi], cols = unknowns_[lo];
+		const Matrix12& m = offDiagonal_[link];
+		for (int col = 0; col < cols; ++col)
+			for (int row = 0; row < rows; ++row) entry(rowBase + row, colBase + col, m(col, row));
+	}
+}
+
+std::size_t CoupledSystem::entryCount(int c) const {
+	return static_cast<std::size_t>(componentStart_[c + 1] - componentStart_[c]) * 78 +
+	       static_cast<std::size_t>(linkStart_[c + 1] - linkStart_[c]) * 144;
+}
+
+bool CoupledSystem::solveFresh(int c, const std::vector<int>& offset, const Eigen::VectorXd& rhs,
+                               Eigen::VectorXd& x) const {
+	const int n = offset.back();
+	std::vector<Eigen::Triplet<double>> entries;
+	entries.reserve(entryCount(c));
+	forEachEntry(c, offset, [&](int row, int col, double value) { entries.emplace_back(row, col, value); });
+	Eigen::SparseMatrix<double> K(n, n);
+	K.setFromTriplets(entries.begin(), entries.end());
+	SparseLLT llt(K);
+	if (llt.info() != Eigen::Success) return false;
+	x = llt.solve(rhs);
+	return true;
+}
+
+bool CoupledSystem::solveKept(int c, const std::vector<int>& offset, Analysis& analysis, const Eigen::VectorXd& rhs,
+                              Eigen::VectorXd& x, int& newAnalyses, int& reusedAnalyses) const {
+	const int n = offset.back();
+	if (analysis.unknowns != n) {
+		// New pattern: the matrix setFromTriplets builds, with each
+		// entry's assembly index as its value, permuted as factorize
+		// would, says where each entry goes.
+		std::vector<Eigen::Triplet<double>> entries;
+		entries.reserve(entryCount(c));
+		forEachEntry(c, offset, [&](int row, int col, double) {
+			entries.emplace_back(row, col, static_cast<double>(entries.size()));
+		});
+		analysePattern(entries, n, analysis.llt, analysis.position);
+		const Eigen::SparseMatrix<double>& permuted = analysis.llt.permuted();
+		analysis.unknowns = n;
+		analysis.bytes = static_cast<std::size_t>(permuted.nonZeros()) * (sizeof(double) + sizeof(int)) +
+		                 capacityBytes(analysis.position) +
+		                 static_cast<std::size_t>(analysis.llt.matrixL().nestedExpression().nonZeros()) *
+		                     (sizeof(double) + sizeof(int)) +
+		                 static_cast<std::size_t>(n) * 6 * sizeof(int);
+		++newAnalyses;
+	} else {
+		++reusedAnalyses;
+	}
+	double* values = analysis.llt.permuted().valuePtr();
+	const int* position = analysis.position.data();
+	std::size_t e = 0;
+	forEachEntry(c, offset, [&](int, int, double value) { values[position[e++]] = value; });
+	analysis.llt.factorizePermuted();
+	if (analysis.llt.info() != Eigen::Success) return false;
+	x = analysis.llt.solve(rhs);
+	return true;
+}
+
 void CoupledSystem::solve(std::vector<Vector12>& solutions, int threadsFrom) {
 	const int count = components();
 	bool failed = false;
@@ -286,75 +357,16 @@ void CoupledSystem::solve(std::vector<Vector12>& solutions, int threadsFrom) {
 		for (int s = first; s < last; ++s) offset[s - first + 1] = offset[s - first] + unknowns_[s];
 		const int n = offset.back();
 		solved += n;
-		// The lower triangle's entries in assembly order: each diagonal
-		// block's, then each link's (the stored K[lo][hi] transposed).
-		auto forEachEntry = [&](auto&& entry) {
-			for (int s = first; s < last; ++s) {
-				const int base = offset[s - first], size = unknowns_[s];
-				for (int col = 0; col < size; ++col)
-					for (int row = col; row < size; ++row) entry(base + row, base + col, diagonal_[s](row, col));
-			}
-			for (int link = linkStart_[c]; link < linkStart_[c + 1]; ++link) {
-				const auto [lo, hi] = linkSlots_[link];
-				const int rowBase = offset[hi - first], colBase = offset[lo - first];
-				const int rows = unknowns_[hi], cols = unknowns_[lo];
-				const Matrix12& m = offDiagonal_[link];
-				for (int col = 0; col < cols; ++col)
-					for (int row = 0; row < rows; ++row) entry(rowBase + row, colBase + col, m(col, row));
-			}
-		};
-		const std::size_t entryCount = static_cast<std::size_t>(last - first) * 78 +
-		                               static_cast<std::size_t>(linkStart_[c + 1] - linkStart_[c]) * 144;
 		Eigen::VectorXd rhs(n);
 		for (int s = first; s < last; ++s) rhs.segment(offset[s - first], unknowns_[s]) = force_[s].head(unknowns_[s]);
 		Analysis* analysis = componentAnalysis_.empty() ? nullptr : componentAnalysis_[c];
 		Eigen::VectorXd x;
-		if (!analysis) {
-			std::vector<Eigen::Triplet<double>> entries;
-			entries.reserve(entryCount);
-			forEachEntry([&](int row, int col, double value) { entries.emplace_back(row, col, value); });
-			Eigen::SparseMatrix<double> K(n, n);
-			K.setFromTriplets(entries.begin(), entries.end());
-			SparseLLT llt(K);
-			if (llt.info() != Eigen::Success) {
+		const bool solvedHere = analysis ? solveKept(c, offset, *analysis, rhs, x, newAnalyses, reusedAnalyses)
+		                                 : solveFresh(c, offset, rhs, x);
+		if (!solvedHere) {
 #pragma omp atomic write
-				failed = true;
-				continue;
-			}
-			x = llt.solve(rhs);
-		} else {
-			if (analysis->unknowns != n) {
-				// New pattern: the matrix setFromTriplets builds, with each
-				// entry's assembly index as its value, permuted as factorize
-				// would, says where each entry goes.
-				std::vector<Eigen::Triplet<double>> entries;
-				entries.reserve(entryCount);
-				forEachEntry([&](int row, int col, double) {
-					entries.emplace_back(row, col, static_cast<double>(entries.size()));
-				});
-				analysePattern(entries, n, analysis->llt, analysis->position);
-				const Eigen::SparseMatrix<double>& permuted = analysis->llt.permuted();
-				analysis->unknowns = n;
-				analysis->bytes = static_cast<std::size_t>(permuted.nonZeros()) * (sizeof(double) + sizeof(int)) +
-				                  capacityBytes(analysis->position) +
-				                  static_cast<std::size_t>(analysis->llt.matrixL().nestedExpression().nonZeros()) *
-				                      (sizeof(double) + sizeof(int)) +
-				                  static_cast<std::size_t>(n) * 6 * sizeof(int);
-				++newAnalyses;
-			} else {
-				++reusedAnalyses;
-			}
-			double* values = analysis->llt.permuted().valuePtr();
-			const int* position = analysis->position.data();
-			std::size_t e = 0;
-			forEachEntry([&](int, int, double value) { values[position[e++]] = value; });
-			analysis->llt.factorizePermuted();
-			if (analysis->llt.info() != Eigen::Success) {
-#pragma omp atomic write
-				failed = true;
-				continue;
-			}
-			x = analysis->llt.solve(rhs);
+			failed = true;
+			continue;
 		}
 		for (int s = first; s < last; ++s) {
 			const int k = members_[s], size = unknowns_[s];

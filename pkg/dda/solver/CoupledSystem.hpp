@@ -107,6 +107,20 @@ private:
 	// Solves the component of the single block in `slot` (a dense Cholesky of
 	// its 12 or 6 unknowns); false when the factorisation fails.
 	bool solveSingleBlock(int slot, std::vector<Vector12>& solutions) const;
+	// Calls entry(row, col, value) for the lower triangle of component c's
+	// matrix in assembly order: each diagonal block's, then each link's
+	// (the stored K[lo][hi] transposed); slot s's unknowns start at
+	// offset[s - first slot].
+	template <class Entry>
+	void forEachEntry(int c, const std::vector<int>& offset, Entry&& entry) const;
+	// Entries of component c's lower triangle [-].
+	std::size_t entryCount(int c) const;
+	// Solves component c's sparse system K x = rhs (n unknowns, slots at
+	// `offset`): a new factorisation, or its kept analysis refilled (counted
+	// in newAnalyses or reusedAnalyses). False when the factorisation fails.
+	bool solveFresh(int c, const std::vector<int>& offset, const Eigen::VectorXd& rhs, Eigen::VectorXd& x) const;
+	bool solveKept(int c, const std::vector<int>& offset, Analysis& analysis, const Eigen::VectorXd& rhs,
+	               Eigen::VectorXd& x, int& newAnalyses, int& reusedAnalyses) const;
 
 	std::vector<int> slot_;            // per moving block: its slot, -1 when it has no springs
 	std::vector<int> members_;         // per slot: the moving block

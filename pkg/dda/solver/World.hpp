@@ -78,6 +78,8 @@ public:
 	// The broad phase (DESSCollider unless set).
 	void setCollider(std::unique_ptr<Collider> collider);
 	const Collider& collider() const { return *collider_; }
+	// (Its settings, e.g. Collider::setCover, taken at the next step.)
+	Collider& collider() { return *collider_; }
 	// Whether the solver keeps work between solves: the sparse components'
 	// analyses (CoupledSystem.hpp) and, within an attempt, the terms of
 	// contacts that neither slip nor carry a secant force (keptTerms_); and
