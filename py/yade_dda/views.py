@@ -77,16 +77,26 @@ def update(scene, engines=None):
 
 
 def _writeForces(bodies):
+    """Makes O.forces hold each block's (force, torque). addF adds, and YADE resets O.forces only
+    where a ForceResetter runs (a DDA scene need not have one): what is missing is added. YADE's
+    container (OpenMP build) sums per-thread buffers when synced, and f(id) without a sync after an
+    addF reads only part of them: all are read synced first, then added to, then synced again."""
+    if not bodies:
+        return
     forces = O.forces
-    for bodyId, force, torque in bodies:
-        # addF adds: add what is missing (YADE resets O.forces only where a
-        # ForceResetter runs, which a DDA scene need not have).
-        current = forces.f(bodyId)
-        if current != force:
-            forces.addF(bodyId, force - current)
-        current = forces.t(bodyId)
-        if current != torque:
-            forces.addT(bodyId, torque - current)
+    first = bodies[0][0]
+    forces.f(first, True)   # sync
+    current = [(forces.f(bodyId), forces.t(bodyId)) for bodyId, _, _ in bodies]
+    changed = False
+    for (bodyId, force, torque), (f, t) in zip(bodies, current):
+        if f != force:
+            forces.addF(bodyId, force - f)
+            changed = True
+        if t != torque:
+            forces.addT(bodyId, torque - t)
+            changed = True
+    if changed:
+        forces.f(first, True)   # sync: f(id) reads the sums
 
 
 def _isLiveLoop(engine):
@@ -126,9 +136,11 @@ def _writeInteractions(scene, pairs, keep):
             phys.kn = kn
             phys.ks = ks
             phys.tangensOfFrictionAngle = tanPhi
-    for id1, id2 in previous - current:
-        if intrs.has(id1, id2):
-            intrs.erase(id1, id2)
+    gone = [pair for pair in previous - current if intrs.has(*pair)]
+    for id1, id2 in gone:
+        intrs.erase(id1, id2)   # YADE's erase leaves a virtual interaction for a collider to remove...
+    if gone and keep:
+        intrs.eraseNonReal()    # ... there is none that would (no live InteractionLoop): remove them here
     scene.viewPairs = current
 
 
@@ -154,3 +166,49 @@ def _tellGravity(gravity, engines):
     # iteration (YADE's _nextEngines). mask=0: it moves no body even for the
     # mask guard (engines._checkEngines); dead: it never runs.
     O.engines = list(O.engines) + [wrapper.NewtonIntegrator(dead=True, mask=0, gravity=gravity, label=GRAVITY_LABEL)]
+
+
+# ------------------------------------------------------------------ O.engines
+
+class _EnginesProperty(property):
+    """Omega.engines that adds the GRAVITY_LABEL NewtonIntegrator (see _tellGravity) when a script
+    assigns engines with a DDA integrator with gravity; ``yadeOriginal`` is YADE's property."""
+    yadeOriginal = None
+
+
+def _integratorGravity(engines):
+    """The gravity [m/s^2] of the first DDA integrator among engines (its command carries its
+    parameters, engines._COMMAND), or None."""
+    import ast
+    from . import engines as _engines
+    prefix = _engines._COMMAND.split('%')[0]
+    for engine in engines:
+        if isinstance(engine, wrapper.PyRunner) and engine.command.startswith(prefix):
+            try:
+                return _engines._parse(ast.literal_eval(engine.command[len(prefix):-1]))[1].gravity
+            except (ValueError, SyntaxError):   # not our command after all: YADE's rules hold
+                return None
+    return None
+
+
+def installEnginesHook():
+    """Wraps YADE's ``Omega.engines`` so that an assignment of engines with a DDA integrator with
+    gravity and no NewtonIntegrator also appends ``NewtonIntegrator(dead=True, mask=0, gravity=g,
+    label='ddaGravity')``: assigned by the script (outside the engine loop) it is in place from the
+    first step, so that ``utils.unbalancedForce`` sees DDA's gravity after ``O.step()`` too."""
+    current = wrapper.Omega.__dict__['engines']
+    original = getattr(current, 'yadeOriginal', None) or current
+
+    def assign(self, engines):
+        engines = list(engines)
+        gravity = _integratorGravity(engines) if _enabled else None
+        if (gravity is not None and gravity.norm() > 0
+                and not any(isinstance(e, wrapper.NewtonIntegrator) for e in engines)):
+            engines.append(wrapper.NewtonIntegrator(dead=True, mask=0, gravity=gravity, label=GRAVITY_LABEL))
+        original.fset(self, engines)
+
+    prop = _EnginesProperty(original.fget, assign, None, (original.__doc__ or '') + (
+        "\n\n(yade_dda: engines with a DDA integrator with gravity and no NewtonIntegrator get a dead "
+        "NewtonIntegrator labelled 'ddaGravity' that carries the gravity for YADE's tools; it never runs.)"))
+    prop.yadeOriginal = original
+    wrapper.Omega.engines = prop
