@@ -18,7 +18,6 @@ bench tools stay out of it and load when first asked for:
 """
 from ._yade import O
 from .hooks import installHooks
-from . import views as _views
 from .blocks import ddaBlock, rigidBlock
 from .engines import DDAIntegrator
 from .colliders import MSCCollider, DESSCollider, NBSCollider, AllPairsCollider
@@ -27,7 +26,6 @@ from .scene import (stats, sync, block, blockOf, setVelocity, addPointLoad, addF
                     printStats, contacts, Ig2_DDABlock_DDABlock_DDAContact)
 
 installHooks()
-_views.installEnginesHook()   # O.engines: the ddaGravity NewtonIntegrator (views.py)
 
 __all__ = ['ddaBlock', 'rigidBlock', 'DDAIntegrator', 'MSCCollider', 'DESSCollider', 'NBSCollider', 'AllPairsCollider',
            'Checkpoint', 'latestCheckpoint', 'stats', 'printStats', 'sync', 'block', 'blockOf',

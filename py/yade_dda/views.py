@@ -24,9 +24,9 @@ bodies: only when something may read them.
   ``O.forces`` for its own bodies (NewtonIntegrator adds gravity to the
   acceleration). Other bodies' forces are not touched. YADE's
   ``utils.unbalancedForce`` adds ``mass x gravity`` of the first
-  NewtonIntegrator in O.engines; when there is none, a dead
-  ``NewtonIntegrator(label='ddaGravity')`` carrying DDA's gravity is
-  appended (it never runs).
+  NewtonIntegrator in O.engines: a script without one adds
+  ``NewtonIntegrator(dead=True, mask=0, gravity=g, label='ddaGravity')``,
+  whose gravity then follows DDA's (it never runs).
 - **Energy.** With ``O.trackEnergy``, ``O.energy`` holds the core's energy
   account (``stats()['energy']``) under ENERGY_NAMES, signed so that
   ``O.energy.total()`` is the conserved balance.
@@ -152,63 +152,12 @@ def _writeEnergy(scene):
 
 
 def _tellGravity(gravity, engines):
-    """Makes the first NewtonIntegrator of O.engines carry DDA's gravity
-    [m/s^2] for YADE's tools (utils.unbalancedForce): a dead one labelled
-    GRAVITY_LABEL is appended when there is none and gravity is not zero."""
+    """Keeps a NewtonIntegrator labelled GRAVITY_LABEL in O.engines (the script adds it, dead:
+    ``NewtonIntegrator(dead=True, mask=0, gravity=g, label='ddaGravity')``) carrying DDA's gravity
+    [m/s^2], for YADE's tools that read gravity there (utils.unbalancedForce). Nothing is added to
+    O.engines: scripts and tests address engines by position."""
     for engine in engines:
-        if isinstance(engine, wrapper.NewtonIntegrator):
-            if engine.label == GRAVITY_LABEL and engine.gravity != gravity:
+        if isinstance(engine, wrapper.NewtonIntegrator) and engine.label == GRAVITY_LABEL:
+            if engine.gravity != gravity:
                 engine.gravity = gravity
             return
-    if gravity.norm() == 0:
-        return
-    # Assigned inside the engine loop, O.engines takes effect at the next
-    # iteration (YADE's _nextEngines). mask=0: it moves no body even for the
-    # mask guard (engines._checkEngines); dead: it never runs.
-    O.engines = list(O.engines) + [wrapper.NewtonIntegrator(dead=True, mask=0, gravity=gravity, label=GRAVITY_LABEL)]
-
-
-# ------------------------------------------------------------------ O.engines
-
-class _EnginesProperty(property):
-    """Omega.engines that adds the GRAVITY_LABEL NewtonIntegrator (see _tellGravity) when a script
-    assigns engines with a DDA integrator with gravity; ``yadeOriginal`` is YADE's property."""
-    yadeOriginal = None
-
-
-def _integratorGravity(engines):
-    """The gravity [m/s^2] of the first DDA integrator among engines (its command carries its
-    parameters, engines._COMMAND), or None."""
-    import ast
-    from . import engines as _engines
-    prefix = _engines._COMMAND.split('%')[0]
-    for engine in engines:
-        if isinstance(engine, wrapper.PyRunner) and engine.command.startswith(prefix):
-            try:
-                return _engines._parse(ast.literal_eval(engine.command[len(prefix):-1]))[1].gravity
-            except (ValueError, SyntaxError):   # not our command after all: YADE's rules hold
-                return None
-    return None
-
-
-def installEnginesHook():
-    """Wraps YADE's ``Omega.engines`` so that an assignment of engines with a DDA integrator with
-    gravity and no NewtonIntegrator also appends ``NewtonIntegrator(dead=True, mask=0, gravity=g,
-    label='ddaGravity')``: assigned by the script (outside the engine loop) it is in place from the
-    first step, so that ``utils.unbalancedForce`` sees DDA's gravity after ``O.step()`` too."""
-    current = wrapper.Omega.__dict__['engines']
-    original = getattr(current, 'yadeOriginal', None) or current
-
-    def assign(self, engines):
-        engines = list(engines)
-        gravity = _integratorGravity(engines) if _enabled else None
-        if (gravity is not None and gravity.norm() > 0
-                and not any(isinstance(e, wrapper.NewtonIntegrator) for e in engines)):
-            engines.append(wrapper.NewtonIntegrator(dead=True, mask=0, gravity=gravity, label=GRAVITY_LABEL))
-        original.fset(self, engines)
-
-    prop = _EnginesProperty(original.fget, assign, None, (original.__doc__ or '') + (
-        "\n\n(yade_dda: engines with a DDA integrator with gravity and no NewtonIntegrator get a dead "
-        "NewtonIntegrator labelled 'ddaGravity' that carries the gravity for YADE's tools; it never runs.)"))
-    prop.yadeOriginal = original
-    wrapper.Omega.engines = prop

@@ -34,7 +34,9 @@ def _stack(n=5, young=1e10, friction=30, **engine):
     O.bodies.append(yade_dda.ddaBlock(box((-3, -3, -1), (3, 3, 0)), material=rock, fixed=True))
     for k in range(n):
         O.bodies.append(yade_dda.ddaBlock(box((0, 0, k), (1, 1, k + 1)), material=rock))
-    O.engines = [yade_dda.DDAIntegrator(dt=1e-3, gravity=(0, 0, -G), label='dda', **engine)]
+    # utils.unbalancedForce adds mass x gravity of the first NewtonIntegrator: a dead one carries it.
+    O.engines = [yade_dda.DDAIntegrator(dt=1e-3, gravity=(0, 0, -G), label='dda', **engine),
+                 wrapper.NewtonIntegrator(dead=True, mask=0, gravity=(0, 0, -1), label=views.GRAVITY_LABEL)]
 
 
 def _closedPairs():
@@ -76,6 +78,7 @@ def test_settled_stack_interactions_forces_energy():
         assert O.forces.f(k) == pytest.approx((0, 0, WEIGHT), abs=0.02 * WEIGHT)
     assert O.forces.f(0)[2] == pytest.approx(-5 * WEIGHT, rel=0.02)   # the floor's reaction
     assert utils.unbalancedForce() < 0.05
+    assert O.engines[1].gravity == (0, 0, -G)   # views set DDA's gravity into it
     # O.energy is the core's account, signed so that total() is the conserved balance.
     account = yade_dda.stats()['energy']
     energy = dict(O.energy.items())
