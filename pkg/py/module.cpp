@@ -15,6 +15,11 @@
 namespace py = boost::python;
 using namespace dda;
 
+namespace dda {
+// Views.cpp: per block pair and per block, what YADE's interactions and forces show.
+py::tuple viewData(const SceneLink& s, const IntegratorSettings& settings);
+}  // namespace dda
+
 namespace {
 
 Vector3 toVector(const py::object& item, const char* what) {
@@ -478,6 +483,10 @@ BOOST_PYTHON_MODULE(_core) {
 	    .def("setStress", &setStress)
 	    .def("step", &step)
 	    .def("syncData", &syncData)
+	    .def("viewData", &dda::viewData, (py::arg("settings")),
+	         "(pairs, bodies) for yade_dda.views: per body pair with a closed contact (id1 < id2, contactPoint, normal "
+	         "from id1 to id2, normalForce and shearForce on id2 [N], kn, ks [N/m], tanPhi); per linked block (body "
+	         "id, force [N], torque about its centroid [N m]), gravity excluded (pkg/py/Views.cpp).")
 	    .def("lastStep", &lastStep)
 	    .def("motionHalfSize", &SceneLink::motionHalfSize)
 	    .def("time", &SceneLink::time)

@@ -203,6 +203,7 @@ def integratorStep(text):
         scene.core.setCover(float(cover[0]), int(cover[1]))
         scene.cover = cover
     writeDt(scene.core.step(settings))
+    scene.settings = settings   # what views.update reads (fixed-point stiffness, gravity)
     if _syncNeeded(params, engines):
         scene.sync()
     scene.stepTimeTotal += time.perf_counter() - start

@@ -14,6 +14,7 @@ import uuid
 from ._yade import O, wrapper
 from . import _core
 from . import state as _state
+from . import views as _views
 
 TAG = 'yade_dda.scene'
 _scenes = {}
@@ -90,6 +91,7 @@ class DDAScene:
             state.angVel = angVel
             if vertices is not None:
                 body.shape.v = vertices
+        _views.update(self)   # O.interactions, O.forces, O.energy (views.py)
         self.syncTime = time.perf_counter() - start
         self.syncTimeTotal += self.syncTime
         self.syncedBodies = len(data)

@@ -1,0 +1,163 @@
+"""What YADE sees of the DDA scene: interactions, forces and energy
+(doc/user-guide.md, "What YADE sees: interactions, forces, energy").
+
+Written at every sync (scene.DDAScene.sync), so under the same policy as the
+bodies: only when something may read them.
+
+- **Interactions.** Every body pair with a closed DDA contact is a real
+  interaction in ``O.interactions`` with a ``PolyhedraGeom`` (contactPoint
+  [m], normal from id1 to id2) and a ``PolyhedraPhys`` (normalForce and
+  shearForce [N] on id2, the force on id1 being their opposite, as YADE's
+  Polyhedra law writes them; kn, ks [N/m]; tangensOfFrictionAngle), id1 <
+  id2. These are YADE's own classes for Polyhedra contacts: the GUI draws
+  them as force chains (Gl1_PolyhedraPhys), PolyhedraPhys is a NormShearPhys
+  (``utils.unbalancedForce``) and the exporters read them. Pairs that open or
+  separate are erased. They are made by ``utils.createInteraction(id1, id2,
+  True)`` (virtual: no dispatcher, no YADE geometry) and made real by setting
+  their geom and phys, so no YADE functor ever runs on them. A live YADE
+  ``InteractionLoop`` visits every interaction and stops YADE on a Polyhedra
+  pair it has no functor for, so while O.engines has one (a mixed scene with
+  YADE contacts) DDA interactions are not kept.
+- **Forces.** ``O.forces.f(id)`` and ``t(id)`` of a DDA block are the sum of
+  the forces [N] on it (contacts, point loads, fixed-point springs) and their
+  torque about its centroid [N m]: gravity excluded, as YADE's
+  ``O.forces`` for its own bodies (NewtonIntegrator adds gravity to the
+  acceleration). Other bodies' forces are not touched. YADE's
+  ``utils.unbalancedForce`` adds ``mass x gravity`` of the first
+  NewtonIntegrator in O.engines: a script without one adds
+  ``NewtonIntegrator(dead=True, mask=0, gravity=g, label='ddaGravity')``,
+  whose gravity then follows DDA's (it never runs).
+- **Energy.** With ``O.trackEnergy``, ``O.energy`` holds the core's energy
+  account (``stats()['energy']``) under ENERGY_NAMES, signed so that
+  ``O.energy.total()`` is the conserved balance.
+"""
+from ._yade import O, wrapper, utils
+from . import _core
+
+ENERGY_NAMES = (
+    # (stats()['energy'] key, O.energy name, sign)
+    ('kinetic', 'ddaKinetic', 1),                # current [J]
+    ('gravity', 'ddaGravity', 1),                # current potential [J]
+    ('strain', 'ddaStrain', 1),                  # current [J]
+    ('contact', 'ddaContact', 1),                # current, the closed contacts' springs [J]
+    ('friction', 'ddaFriction', 1),              # cumulative, dissipated [J]
+    ('damping', 'ddaDamping', 1),                # cumulative, dissipated [J]
+    ('loads', 'ddaLoads', -1),                   # cumulative, minus the work of loads and fixed points [J]
+    ('contactChanges', 'ddaContactChanges', -1),  # cumulative, minus what detection gave the springs [J]
+)
+GRAVITY_LABEL = 'ddaGravity'
+"""Label of the dead NewtonIntegrator that tells YADE's tools DDA's gravity."""
+
+_DEFAULT_SETTINGS = _core.IntegratorSettings()
+_enabled = True
+
+
+def setEnabled(flag):
+    """Keeps O.interactions, O.forces and O.energy in step with the DDA scene
+    (True, the default) or not (False: nothing is written; what was written
+    stays)."""
+    global _enabled
+    _enabled = bool(flag)
+
+
+def update(scene, engines=None):
+    """Writes the DDA scene's interactions, forces and energy into YADE's
+    containers (called by DDAScene.sync)."""
+    if not _enabled:
+        return
+    settings = getattr(scene, 'settings', None) or _DEFAULT_SETTINGS
+    pairs, bodies = scene.core.viewData(settings)
+    _writeForces(bodies)
+    engines = O.engines if engines is None else engines
+    _writeInteractions(scene, pairs, not any(_isLiveLoop(e) for e in engines))
+    if O.trackEnergy:
+        _writeEnergy(scene)
+    if getattr(scene, 'settings', None) is not None:
+        _tellGravity(settings.gravity, engines)
+
+
+def _writeForces(bodies):
+    """Makes O.forces hold each block's (force, torque). addF adds, and YADE resets O.forces only
+    where a ForceResetter runs (a DDA scene need not have one): what is missing is added. YADE's
+    container (OpenMP build) sums per-thread buffers when synced, and f(id) without a sync after an
+    addF reads only part of them: all are read synced first, then added to, then synced again."""
+    if not bodies:
+        return
+    forces = O.forces
+    first = bodies[0][0]
+    forces.f(first, True)   # sync
+    current = [(forces.f(bodyId), forces.t(bodyId)) for bodyId, _, _ in bodies]
+    changed = False
+    for (bodyId, force, torque), (f, t) in zip(bodies, current):
+        if f != force:
+            forces.addF(bodyId, force - f)
+            changed = True
+        if t != torque:
+            forces.addT(bodyId, torque - t)
+            changed = True
+    if changed:
+        forces.f(first, True)   # sync: f(id) reads the sums
+
+
+def _isLiveLoop(engine):
+    return isinstance(engine, (wrapper.InteractionLoop, wrapper.IGeomDispatcher)) and not engine.dead
+
+
+def _ddaPairs(scene):
+    """Real interactions between two DDA blocks now in O.interactions (those
+    a loaded scene brought along)."""
+    blocks = set(scene.bodyOfBlock)
+    return {(i.id1, i.id2) for i in O.interactions if i.id1 in blocks and i.id2 in blocks}
+
+
+def _writeInteractions(scene, pairs, keep):
+    intrs = O.interactions
+    previous = getattr(scene, 'viewPairs', None)
+    if previous is None:
+        previous = _ddaPairs(scene)
+    current = set()
+    if keep:
+        Geom, Phys = wrapper.PolyhedraGeom, wrapper.PolyhedraPhys
+        for id1, id2, point, normal, normalForce, shearForce, kn, ks, tanPhi in pairs:
+            current.add((id1, id2))
+            try:
+                i = intrs[id1, id2]
+            except IndexError:
+                i = utils.createInteraction(id1, id2, True)   # virtual: no functor runs
+            geom, phys = i.geom, i.phys
+            if not isinstance(geom, Geom):
+                geom = i.geom = Geom()
+            if not isinstance(phys, Phys):
+                phys = i.phys = Phys()
+            geom.contactPoint = point
+            geom.normal = normal
+            phys.normalForce = normalForce
+            phys.shearForce = shearForce
+            phys.kn = kn
+            phys.ks = ks
+            phys.tangensOfFrictionAngle = tanPhi
+    gone = [pair for pair in previous - current if intrs.has(*pair)]
+    for id1, id2 in gone:
+        intrs.erase(id1, id2)   # YADE's erase leaves a virtual interaction for a collider to remove...
+    if gone and keep:
+        intrs.eraseNonReal()    # ... there is none that would (no live InteractionLoop): remove them here
+    scene.viewPairs = current
+
+
+def _writeEnergy(scene):
+    account = scene.core.lastStep()['energy']
+    energy = O.energy
+    for key, name, sign in ENERGY_NAMES:
+        energy[name] = sign * account[key]
+
+
+def _tellGravity(gravity, engines):
+    """Keeps a NewtonIntegrator labelled GRAVITY_LABEL in O.engines (the script adds it, dead:
+    ``NewtonIntegrator(dead=True, mask=0, gravity=g, label='ddaGravity')``) carrying DDA's gravity
+    [m/s^2], for YADE's tools that read gravity there (utils.unbalancedForce). Nothing is added to
+    O.engines: scripts and tests address engines by position."""
+    for engine in engines:
+        if isinstance(engine, wrapper.NewtonIntegrator) and engine.label == GRAVITY_LABEL:
+            if engine.gravity != gravity:
+                engine.gravity = gravity
+            return
