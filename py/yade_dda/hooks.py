@@ -199,6 +199,60 @@ def _wrapDt(original):
     return dt
 
 
+# ------------------------------------------------------------------ utils.unbalancedForce
+
+def unbalancedForce(useMaxForce=False):
+    """YADE's ``utils.unbalancedForce``, with DDA blocks' gravity: the mean (or
+    with ``useMaxForce`` the largest) norm of the resultant force on the
+    dynamic bodies over the mean norm of the real interactions' forces
+    (``normalForce + shearForce``) [-]. YADE adds ``mass x gravity`` of the
+    first NewtonIntegrator in O.engines to every dynamic body's ``O.forces``
+    (which excludes gravity); a DDA block gets the gravity of the DDA step
+    instead (``O.forces`` holds its contacts, point loads and fixed points,
+    yade_dda.views), other bodies YADE's. A resting pile then reads about 0,
+    as YADE's spheres do, with no NewtonIntegrator in the scene. Clumps are
+    taken as YADE takes them when their forces are current. NaN when nothing
+    is dynamic or no interaction is real, as YADE's."""
+    scene = _scene.current(create=False)
+    original = unbalancedForce._yadeDDA
+    if scene is None or not scene.bodyOfBlock:
+        return original(useMaxForce)
+    newton = next((e for e in O.engines if isinstance(e, wrapper.NewtonIntegrator)), None)
+    yadeGravity = newton.gravity if newton is not None else None
+    settings = getattr(scene, 'settings', None)
+    ddaGravity = settings.gravity if settings is not None else None
+    blocks = set(scene.bodyOfBlock)
+    forces = O.forces
+    norms = []
+    for body in O.bodies:
+        if body is None or body.isClumpMember or not body.dynamic:
+            continue
+        f = forces.f(body.id, True) if not norms else forces.f(body.id)
+        gravity = ddaGravity if body.id in blocks else yadeGravity
+        if gravity is not None:
+            f = f + body.state.mass * gravity
+        norms.append(f.norm())
+    contacts = [(i.phys.normalForce + i.phys.shearForce).norm() for i in O.interactions
+                if isinstance(i.phys, wrapper.NormShearPhys)]
+    if not norms or not contacts:
+        return float('nan')
+    body = max(norms) if useMaxForce else sum(norms) / len(norms)
+    return body / (sum(contacts) / len(contacts))
+
+
+def _installUnbalancedForce():
+    """Puts unbalancedForce in place of YADE's in yade.utils, yade._utils and a
+    running script's namespace (YADE's launcher binds the name there before
+    the script runs ``import yade_dda``)."""
+    import sys
+    from yade import _utils, utils as yadeUtils
+    current = yadeUtils.unbalancedForce
+    unbalancedForce._yadeDDA = getattr(current, '_yadeDDA', current)
+    for namespace in (yadeUtils.__dict__, _utils.__dict__, getattr(sys.modules.get('__main__'), '__dict__', {})):
+        if namespace.get('unbalancedForce') is unbalancedForce._yadeDDA:
+            namespace['unbalancedForce'] = unbalancedForce
+
+
 def installHooks():
     """Wraps YADE's ``BodyContainer`` and ``Omega`` methods so that the DDA core
     follows the YADE scene. ``import yade_dda`` calls it once; calling it
@@ -224,6 +278,9 @@ def installHooks():
       the integrator's next step makes it ``DDAIntegrator.dt``, its largest
       step (engines.integratorStep). The integrator's own writes go through
       YADE's setter (writeDt).
+    - ``utils.unbalancedForce`` (in yade.utils, yade._utils and the running
+      script's namespace): DDA blocks count with the DDA step's gravity,
+      which YADE would take from a NewtonIntegrator (unbalancedForce above).
     """
     for cls, names, wrap in ((wrapper.BodyContainer, ('erase',), _wrapErase),
                              (wrapper.BodyContainer, ('clear',), _wrapClear),
@@ -233,3 +290,4 @@ def installHooks():
         for name in names:
             setattr(cls, name, wrap(_original(cls, name)))
     wrapper.Omega.dt = _wrapDt(_yadeDt())
+    _installUnbalancedForce()

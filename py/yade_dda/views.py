@@ -24,9 +24,8 @@ bodies: only when something may read them.
   ``O.forces`` for its own bodies (NewtonIntegrator adds gravity to the
   acceleration). Other bodies' forces are not touched. YADE's
   ``utils.unbalancedForce`` adds ``mass x gravity`` of the first
-  NewtonIntegrator in O.engines: a script without one adds
-  ``NewtonIntegrator(dead=True, mask=0, gravity=g, label='ddaGravity')``,
-  whose gravity then follows DDA's (it never runs).
+  NewtonIntegrator in O.engines; yade_dda's replacement (hooks.unbalancedForce)
+  adds the DDA step's gravity to DDA blocks instead.
 - **Energy.** With ``O.trackEnergy``, ``O.energy`` holds the core's energy
   account (``stats()['energy']``) under ENERGY_NAMES, signed so that
   ``O.energy.total()`` is the conserved balance.
@@ -45,8 +44,6 @@ ENERGY_NAMES = (
     ('loads', 'ddaLoads', -1),                   # cumulative, minus the work of loads and fixed points [J]
     ('contactChanges', 'ddaContactChanges', -1),  # cumulative, minus what detection gave the springs [J]
 )
-GRAVITY_LABEL = 'ddaGravity'
-"""Label of the dead NewtonIntegrator that tells YADE's tools DDA's gravity."""
 
 _DEFAULT_SETTINGS = _core.IntegratorSettings()
 _enabled = True
@@ -72,8 +69,6 @@ def update(scene, engines=None):
     _writeInteractions(scene, pairs, not any(_isLiveLoop(e) for e in engines))
     if O.trackEnergy:
         _writeEnergy(scene)
-    if getattr(scene, 'settings', None) is not None:
-        _tellGravity(settings.gravity, engines)
 
 
 def _writeForces(bodies):
@@ -149,15 +144,3 @@ def _writeEnergy(scene):
     energy = O.energy
     for key, name, sign in ENERGY_NAMES:
         energy[name] = sign * account[key]
-
-
-def _tellGravity(gravity, engines):
-    """Keeps a NewtonIntegrator labelled GRAVITY_LABEL in O.engines (the script adds it, dead:
-    ``NewtonIntegrator(dead=True, mask=0, gravity=g, label='ddaGravity')``) carrying DDA's gravity
-    [m/s^2], for YADE's tools that read gravity there (utils.unbalancedForce). Nothing is added to
-    O.engines: scripts and tests address engines by position."""
-    for engine in engines:
-        if isinstance(engine, wrapper.NewtonIntegrator) and engine.label == GRAVITY_LABEL:
-            if engine.gravity != gravity:
-                engine.gravity = gravity
-            return

@@ -34,9 +34,7 @@ def _stack(n=5, young=1e10, friction=30, **engine):
     O.bodies.append(yade_dda.ddaBlock(box((-3, -3, -1), (3, 3, 0)), material=rock, fixed=True))
     for k in range(n):
         O.bodies.append(yade_dda.ddaBlock(box((0, 0, k), (1, 1, k + 1)), material=rock))
-    # utils.unbalancedForce adds mass x gravity of the first NewtonIntegrator: a dead one carries it.
-    O.engines = [yade_dda.DDAIntegrator(dt=1e-3, gravity=(0, 0, -G), label='dda', **engine),
-                 wrapper.NewtonIntegrator(dead=True, mask=0, gravity=(0, 0, -1), label=views.GRAVITY_LABEL)]
+    O.engines = [yade_dda.DDAIntegrator(dt=1e-3, gravity=(0, 0, -G), label='dda', **engine)]
 
 
 def _closedPairs():
@@ -78,7 +76,6 @@ def test_settled_stack_interactions_forces_energy():
         assert O.forces.f(k) == pytest.approx((0, 0, WEIGHT), abs=0.02 * WEIGHT)
     assert O.forces.f(0)[2] == pytest.approx(-5 * WEIGHT, rel=0.02)   # the floor's reaction
     assert utils.unbalancedForce() < 0.05
-    assert O.engines[1].gravity == (0, 0, -G)   # views set DDA's gravity into it
     # O.energy is the core's account, signed so that total() is the conserved balance.
     account = yade_dda.stats()['energy']
     energy = dict(O.energy.items())
@@ -215,3 +212,23 @@ def test_keeping_views_does_not_change_the_dda_motion():
     withoutViews, none = _run_pile(False)
     assert none == 0
     assert withViews == withoutViews
+
+
+def test_unbalanced_force_is_yades_with_ddas_gravity():
+    """Oracle: YADE's own unbalancedForce, given DDA's gravity through a NewtonIntegrator that never
+    runs, equals the replacement without one, in mid-fall (where it is large) and at rest."""
+    from yade_dda import hooks
+    _stack(n=3)
+    ratios = []
+    for steps in (1, 400):
+        O.run(steps, True)
+        ours = utils.unbalancedForce()
+        engines = list(O.engines)
+        O.engines = engines + [wrapper.NewtonIntegrator(dead=True, mask=0, gravity=(0, 0, -G))]
+        yades = hooks.unbalancedForce._yadeDDA()
+        O.engines = engines
+        assert ours == pytest.approx(yades, rel=1e-12, abs=1e-15)
+        ratios.append(ours)
+    assert ratios[-1] < 0.05
+    import yade.utils
+    assert yade.utils.unbalancedForce is hooks.unbalancedForce
