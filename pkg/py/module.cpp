@@ -428,6 +428,8 @@ BOOST_PYTHON_MODULE(_core) {
 	         py::arg("cohesion") = 0.0, py::arg("tensileStrength") = 0.0),
 	        "Raises ValueError naming the problem if the points and material cannot make a DDA block.");
 
+	py::scope().attr("__version__") = YADE_DDA_VERSION;  // CMakeLists.txt's project version
+
 	py::def("hullCorners", &pythonHullCorners, py::arg("points"),
 	        "Indices of the points [m] that are the corners of their convex hull, in input order (points inside the "
 	        "hull, repeats and points on a face or an edge of it within the coplanar tolerance are left out); "

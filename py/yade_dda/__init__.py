@@ -17,6 +17,7 @@ bench tools stay out of it and load when first asked for:
 (yade_dda.accuracy) and ``from yade_dda import regression``.
 """
 from ._yade import O
+from ._core import __version__  # noqa: F401  (CMakeLists.txt's project version)
 from .hooks import installHooks
 from .blocks import ddaBlock, rigidBlock
 from .engines import DDAIntegrator
