@@ -312,12 +312,41 @@ def _client(workers, scheduler, retries, stream):
               '(the scheduler\'s distributed.scheduler.allowed-failures)'
               % (scheduler, len(client.scheduler_info()['workers']), allowed), file=stream, flush=True)
         return client, None
-    with dask.config.set({'distributed.scheduler.allowed-failures': retries}):
+    # One row at a time on each worker, the others queued on the scheduler (for tables of more than
+    # twice as many rows as workers: Dask's root-task queuing), so a lost worker takes only its own row.
+    with dask.config.set({'distributed.scheduler.allowed-failures': retries,
+                          'distributed.scheduler.worker-saturation': 1.0}):
         cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host='127.0.0.1',
                                dashboard_address=None)
     print('sweep: local cluster, %d worker processes of 1 thread; Dask resubmits a row whose worker dies '
           'up to %d times' % (workers, retries), file=stream, flush=True)
     return Client(cluster), cluster
+
+
+class _LightWorkers:
+    """While a local cluster lives: its worker processes do not import yade_dda (which boots YADE).
+
+    The tasks are pickled by value (cloudpickle), so no worker needs this
+    module. Under ``python3 -m yade_dda.sweep``, multiprocessing's spawn would
+    re-import the main module by its name, package first, in every worker
+    (and in each one a nanny restarts); without ``__main__.__spec__`` it runs
+    this file by its path instead, which imports only the standard library.
+    """
+
+    def __enter__(self):
+        import cloudpickle
+        module = sys.modules[__name__]
+        if __name__ != '__main__' and __name__ not in cloudpickle.list_registry_pickle_by_value():
+            cloudpickle.register_pickle_by_value(module)
+        self.main = sys.modules['__main__']
+        self.spec = getattr(self.main, '__spec__', None)
+        if self.main is module:
+            self.main.__spec__ = None
+        return self
+
+    def __exit__(self, *exc):
+        if self.main.__dict__.get('__spec__', None) is None and self.spec is not None:
+            self.main.__spec__ = self.spec
 
 
 def _collect(client, specs, out, progress):
@@ -371,15 +400,16 @@ def runRows(specs, out, workers=None, scheduler=None, retries=3, stream=None, na
     _deleteOld(specs, out)
     start = time.time()
     progress = Progress(specs, stream)
-    client, cluster = _client(workers or os.cpu_count() or 1, scheduler, retries, stream)
-    try:
-        client.subscribe_topic(TOPIC, progress.started)
-        print('sweep: %s, %d rows; records and logs in %s' % (name, len(specs), out), file=stream, flush=True)
-        failed = _collect(client, specs, out, progress)
-    finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
+    with _LightWorkers():
+        client, cluster = _client(workers or os.cpu_count() or 1, scheduler, retries, stream)
+        try:
+            client.subscribe_topic(TOPIC, progress.started)
+            print('sweep: %s, %d rows; records and logs in %s' % (name, len(specs), out), file=stream, flush=True)
+            failed = _collect(client, specs, out, progress)
+        finally:
+            client.close()
+            if cluster is not None:
+                cluster.close()
     _report(specs, failed, out, time.time() - start, stream)
     return len(failed)
 
