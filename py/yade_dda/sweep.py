@@ -8,8 +8,9 @@ the scene of each row, ``description`` the name of its record) runs as
 ``yade --threads=1 --nice=10 -x SCENE`` with ``YADE_BATCH=TABLE:LINE``, as
 ``yade-batch`` runs it, inside one task of Dask distributed: on a
 ``LocalCluster`` of N worker processes with one thread each (default), or on
-the workers of an existing scheduler (``--scheduler tcp://host:8786``: a SLURM
-or Kubernetes cluster, doc/user-guide.md, "Sweeps on a cluster").
+the workers of an existing scheduler (``--scheduler tcp://host:8786``, or the
+scheduler file of ``dask scheduler --scheduler-file``: a SLURM or Kubernetes
+cluster, doc/user-guide.md, "Sweeps on a cluster").
 
 The scene writes its record into a directory private to the task (the
 worker's local directory); the task sends the record and the scene's output
@@ -306,11 +307,12 @@ def _client(workers, scheduler, retries, stream):
     import dask
     from distributed import Client, LocalCluster
     if scheduler:
-        client = Client(scheduler)
+        client = Client(scheduler_file=scheduler) if os.path.isfile(scheduler) else Client(scheduler)
         allowed = client.run_on_scheduler(lambda dask_scheduler: dask_scheduler.allowed_failures)
-        print('sweep: scheduler %s, %d workers; Dask resubmits a row whose worker dies up to %d times '
+        workers = len(client.scheduler_info()['workers'])
+        print('sweep: scheduler %s, %d worker%s connected; Dask resubmits a row whose worker dies up to %d times '
               '(the scheduler\'s distributed.scheduler.allowed-failures)'
-              % (scheduler, len(client.scheduler_info()['workers']), allowed), file=stream, flush=True)
+              % (scheduler, workers, '' if workers == 1 else 's', allowed), file=stream, flush=True)
         return client, None
     # One row at a time on each worker, the others queued on the scheduler (for tables of more than
     # twice as many rows as workers: Dask's root-task queuing), so a lost worker takes only its own row.
@@ -423,7 +425,8 @@ def main(argv=None):
     where.add_argument('--workers', type=int, default=None,
                        help='worker processes of the local cluster, one thread each (default: the cores, %d)'
                        % (os.cpu_count() or 1))
-    where.add_argument('--scheduler', default=None, help='address of a running Dask scheduler (tcp://host:8786)')
+    where.add_argument('--scheduler', default=None, help='a running Dask scheduler: its address (tcp://host:8786) '
+                       'or the file `dask scheduler --scheduler-file FILE` wrote')
     parser.add_argument('--lines', default=None, help="rows of the table to run, yade-batch's syntax (2,5-7)")
     parser.add_argument('--scenes', default=None, help="directory of the scenes named in !SCRIPT, and their "
                         "working directory (default: the table's directory)")

@@ -12,10 +12,13 @@
 - In the same run a row whose scene raises is reported FAILED with the path
   and the last lines of its log (the exception), writes no record, and the
   command exits 1; the other rows' records are written.
+- An existing scheduler (`dask scheduler`, `dask worker` started apart, on
+  the loopback): two rows of the quick table through its scheduler file.
 
-About 25 s on the 2-core machine for the quick table and 20 s for the kill
-(each YADE process starts in about 2 s; the client and each worker start
-YADE once more when they import yade_dda).
+About 11 s on the 2-core machine for the quick table, 5 s for the kill and
+5 s for the existing scheduler (each YADE process starts in about 1 s; the
+sweep's own process starts YADE once more, as it imports yade_dda; the
+workers do not).
 """
 import json
 import os
@@ -217,3 +220,43 @@ def test_a_failing_row_is_reported_with_its_log(killed):
     assert os.path.exists(os.path.join(out, 'plain.json')) and os.path.exists(os.path.join(out, 'killed-once.json'))
     code, report = run_check(killed['table'], out)
     assert code == 1 and 'RuntimeError' in report           # check.py shows the end of the same log
+
+
+# ---------------------------------------------------------------- an existing scheduler
+
+def test_an_existing_scheduler_runs_the_rows(tmp_path):
+    """`dask scheduler` and `dask worker` started apart (as srun would start them), on this machine's
+    loopback; the workers' Python has no yade_dda on its path (tasks travel by value), the scenes get
+    the sweep's through PYTHONPATH. The sweep reaches the scheduler through its scheduler file."""
+    env = {k: v for k, v in os.environ.items() if k not in ('PYTHONPATH', 'YADE_DDA_BUILD')}
+    schedulerFile = tmp_path / 'scheduler.json'
+    started = []
+    try:
+        started.append(subprocess.Popen(['dask', 'scheduler', '--host', '127.0.0.1', '--port', '0', '--no-dashboard',
+                                         '--scheduler-file', str(schedulerFile)], cwd=str(tmp_path), env=env,
+                                        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        deadline = time.time() + 60
+        while not schedulerFile.exists() and time.time() < deadline:
+            time.sleep(0.2)
+        started.append(subprocess.Popen(['dask', 'worker', '--scheduler-file', str(schedulerFile), '--nthreads', '1',
+                                         '--no-dashboard', '--local-directory', str(tmp_path)], cwd=str(tmp_path),
+                                        env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        lines = table_lines(QUICK)
+        rows = '%d,%d' % (lines['freefall-dt1e-2'], lines['incline-a30-phi20'])
+        out = tmp_path / 'out'
+        result = subprocess.run(SWEEP + [QUICK, '--scheduler', str(schedulerFile), '--lines', rows, '--out', str(out)],
+                                env=scene_env(), capture_output=True, text=True, timeout=300)
+    finally:
+        for proc in reversed(started):        # the scheduler and worker this test started
+            proc.terminate()
+            try:
+                proc.wait(timeout=30)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait()
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert 'sweep: scheduler %s, ' % schedulerFile in result.stdout      # not a local cluster
+    code, report = run_check(QUICK, str(out), '--lines', rows)
+    assert code == 0, report
+    assert sorted(os.listdir(out)) == ['freefall-dt1e-2.json', 'freefall-dt1e-2.log',
+                                       'incline-a30-phi20.json', 'incline-a30-phi20.log']
