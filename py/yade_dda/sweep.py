@@ -55,6 +55,7 @@ import sys
 import tempfile
 import threading
 import time
+import uuid
 
 TOPIC = 'yade-dda-sweep'
 """Dask event topic on which a task says that its row started."""
@@ -109,7 +110,8 @@ def rowSpecs(table, lines=None, scenes=None, executable='yade', threads=1, nice=
                          % (table, ', '.join(duplicates)))
     inside = os.path.commonpath([table, scenes]) == scenes
     tableName = os.path.relpath(table, scenes) if inside else table
-    return [_rowSpec(rows[line], line, table, tableName, scenes, executable, threads, nice, timeout)
+    run = uuid.uuid4().hex[:12]         # names this sweep's tasks and events on a shared scheduler
+    return [dict(_rowSpec(rows[line], line, table, tableName, scenes, executable, threads, nice, timeout), run=run)
             for line in lines]
 
 
@@ -154,8 +156,8 @@ def runRow(spec):
         raise FileNotFoundError('scene %s not found on %s (%s): workers need the scenes at the same path'
                                 % (spec['script'], where, socket.gethostname()))
     if worker:
-        worker.log_event(TOPIC, {'line': spec['line'], 'worker': where, 'host': socket.gethostname(),
-                                 'pid': os.getpid()})
+        worker.log_event(TOPIC, {'run': spec['run'], 'line': spec['line'], 'worker': where,
+                                 'host': socket.gethostname(), 'pid': os.getpid()})
     parent = worker.local_directory if worker else None
     work = tempfile.mkdtemp(prefix='row%d-' % spec['line'], dir=parent)
     try:
@@ -235,6 +237,7 @@ class Progress:
     """Counts attempts (from the tasks' start events) and prints one line per event."""
 
     def __init__(self, specs, stream):
+        self.run = specs[0]['run'] if specs else None
         self.specs = {s['line']: s for s in specs}
         self.attempts = {s['line']: 0 for s in specs}
         self.done, self.total, self.stream = 0, len(specs), stream
@@ -245,8 +248,11 @@ class Progress:
             print(text, file=self.stream, flush=True)
 
     def started(self, event):
-        """Handler of the TOPIC events: (timestamp, {'line', 'worker', 'host', 'pid'})."""
+        """Handler of the TOPIC events: (timestamp, {'run', 'line', 'worker', 'host', 'pid'}); events of
+        another sweep on the same scheduler are not ours."""
         msg = event[1]
+        if msg.get('run') != self.run:
+            return
         with self.lock:
             self.attempts[msg['line']] += 1
             attempt = self.attempts[msg['line']]
@@ -347,15 +353,16 @@ class _LightWorkers:
         return self
 
     def __exit__(self, *exc):
-        if self.main.__dict__.get('__spec__', None) is None and self.spec is not None:
+        if self.main is sys.modules[__name__]:
             self.main.__spec__ = self.spec
 
 
 def _collect(client, specs, out, progress):
     """Submits every row, stores each result as it arrives; returns {line: problem} of the failed rows."""
     from distributed import as_completed
-    futures = {client.submit(runRow, spec, key='yade-dda-row-%d-%s' % (spec['line'], spec['description']),
-                             pure=False): spec for spec in specs}
+    futures = {client.submit(runRow, spec, key='yade-dda-row-%d-%s-%s' % (spec['line'], spec['description'],
+                                                                          spec['run']), pure=False): spec
+               for spec in specs}
     failed = {}
     for future in as_completed(list(futures)):
         spec = futures[future]
@@ -444,7 +451,11 @@ def main(argv=None):
         specs = rowSpecs(args.table, lines, args.scenes, args.yade, 1, args.nice, args.timeout)
     except ValueError as e:
         parser.error(str(e))
-    failed = runRows(specs, args.out, args.workers, args.scheduler, args.retries, name=args.table)
+    try:
+        failed = runRows(specs, args.out, args.workers, args.scheduler, args.retries, name=args.table)
+    except KeyboardInterrupt:
+        print('sweep: interrupted; rows not finished left no record', file=sys.stderr)
+        return 130
     return 1 if failed else 0
 
 

@@ -183,7 +183,8 @@ def killed(tmp_path_factory):
             proc.wait()
         if scene and alive(scene):
             os.kill(scene, signal.SIGKILL)     # the scene this test started, left behind by a failure
-    return {'code': code, 'output': (work / 'sweep.out').read_text(), 'out': str(out), 'table': str(work / 'hold.table'),
+    return {'code': code, 'output': (work / 'sweep.out').read_text(), 'out': str(out),
+            'table': str(work / 'hold.table'),
             'scene': scene, 'worker': worker, 'workerParent': workerParent, 'sweep': proc.pid,
             'sceneSurvived': sceneSurvived}
 
