@@ -5,10 +5,10 @@ BUILD    := build
 JOBS     ?= 2
 DEB_PACKAGES := yade cmake g++ make libeigen3-dev libcgal-dev libgmp-dev libmpfr-dev \
                 libboost-python-dev python3-dev python3-pytest python3-numpy python3-matplotlib python3-vtk9 \
-                libgtest-dev
+                python3-distributed libgtest-dev
 SITE_DIR := $(shell $(PYTHON) -c "import sysconfig;print(sysconfig.get_path('purelib','posix_local'))" 2>/dev/null)
 
-.PHONY: deps build install demo test test-hard test-cpp test-py bench bench-pile200 fingerprints docs regress regress-quick regress-run fuzz mutations clean
+.PHONY: deps build install demo test test-hard test-cpp test-py bench bench-pile200 fingerprints docs regress regress-quick regress-run sweep fuzz mutations clean
 
 deps:
 	@missing=$$(for p in $(DEB_PACKAGES); do dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null | grep -q 'install ok installed' || echo $$p; done); \
@@ -90,6 +90,22 @@ regress-run:
 	(cd examples/regression && YADE_DDA_RECORDS=$$out $(YADE_BATCH) -j $(JOBS) --disable-pynotify \
 	    --log "$$out/@.log" $(TABLE).table 2>&1) | tee $$out/yade-batch.log | grep --line-buffered -E '^#[0-9]+ \('; true
 	$(PYTHON) examples/regression/check.py examples/regression/$(TABLE).table $(abspath $(REGRESS_OUT))/$(TABLE) $(CHECK_ARGS)
+
+# Sweeps on a cluster (doc/user-guide.md, "Sweeps on a cluster"): every row of a yade-batch table as its own
+# YADE process on Dask distributed (python3 -m yade_dda.sweep), with the build tree's yade_dda; a local
+# cluster of JOBS single-threaded workers unless SWEEP_ARGS says otherwise (--scheduler tcp://HOST:8786,
+# --workers N, --timeout S). TABLE is a path or the name of a table in examples/regression (default quick).
+# Records and logs go to $(SWEEP_OUT)/<table>; a table of examples/regression is then checked by check.py.
+SWEEP_OUT  := $(BUILD)/sweep
+SWEEP_ARGS ?= --workers $(JOBS)
+sweep: build
+	@table=$(TABLE); [ -f "$$table" ] || table=examples/regression/$(TABLE).table; \
+	out=$(abspath $(SWEEP_OUT))/$$(basename $$table .table); mkdir -p $$out; \
+	{ PYTHONPATH=$(abspath $(BUILD))/py $(PYTHON) -m yade_dda.sweep $$table --out $$out $(SWEEP_ARGS) 2>&1; \
+	  echo $$? > $$out/sweep.status; } | grep --line-buffered -v '^Using python version' | tee $$out/sweep.log; \
+	status=$$(cat $$out/sweep.status); \
+	if [ "$$(cd $$(dirname $$table) && pwd)" = "$(abspath examples/regression)" ]; then \
+	  $(PYTHON) examples/regression/check.py $$table $$out $(CHECK_ARGS) || status=1; fi; exit $$status
 
 # Longer fuzzing of the geometry and contact kernels (doc/testing.md, "Fuzzing"): tests/fuzz's target built
 # with AddressSanitizer and UBSan in its own build tree, fed by the plain driver for FUZZ_SECONDS with

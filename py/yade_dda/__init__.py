@@ -13,8 +13,10 @@ All quantities are SI: metres, seconds, kilograms, pascals, newtons, radians.
 
 ``from yade_dda import *`` gives what a scene script uses (``__all__``). The
 bench tools stay out of it and load when first asked for:
-``yade_dda.compareColliders`` (yade_dda.compare), ``yade_dda.sweep``
-(yade_dda.accuracy) and ``from yade_dda import regression``.
+``yade_dda.compareColliders`` (yade_dda.compare), ``yade_dda.accuracySweep``
+(``yade_dda.accuracy.sweep``), ``from yade_dda import regression`` and the
+module ``yade_dda.sweep`` (``python3 -m yade_dda.sweep``: a yade-batch table
+on Dask distributed).
 """
 from ._yade import O
 from ._core import __version__  # noqa: F401  (CMakeLists.txt's project version)
@@ -33,7 +35,7 @@ __all__ = ['ddaBlock', 'rigidBlock', 'DDAIntegrator', 'MSCCollider', 'DESSCollid
            'Checkpoint', 'latestCheckpoint', 'DDAVTKRecorder', 'stats', 'printStats', 'sync', 'block', 'blockOf',
            'setVelocity', 'addPointLoad', 'addFixedPoint', 'contacts', 'Ig2_DDABlock_DDABlock_DDAContact', 'O']
 
-_TOOLS = ('compare', 'accuracy', 'regression', 'compareColliders', 'sweep')
+_TOOLS = ('compare', 'accuracy', 'regression', 'compareColliders', 'accuracySweep', 'sweep')
 """Bench tools: attributes of the package, loaded on first use, out of ``import *``."""
 
 
@@ -44,10 +46,13 @@ def __getattr__(name):
     if name in ('compare', 'compareColliders'):
         from .compare import compareColliders
         return compareColliders if name == 'compareColliders' else globals()['compare']
-    if name in ('accuracy', 'sweep'):
+    if name in ('accuracy', 'accuracySweep'):
         from .accuracy import sweep
-        return sweep if name == 'sweep' else globals()['accuracy']
+        return sweep if name == 'accuracySweep' else globals()['accuracy']
     if name == 'regression':
         from .regression import versions  # noqa: F401
         return globals()['regression']
+    if name == 'sweep':
+        from .sweep import runRows  # noqa: F401
+        return globals()['sweep']
     raise AttributeError('module %r has no attribute %r' % (__name__, name))

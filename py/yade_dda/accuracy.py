@@ -8,7 +8,7 @@ A scene is two callables (SI units throughout)::
     def measure():               # after the run: the error against your closed form
         return abs(x - exact)    # a float [your unit], or a dict with at least 'error'
 
-    from yade_dda import sweep
+    from yade_dda.accuracy import sweep      # also yade_dda.accuracySweep
     points = sweep(build, measure, knob='dt', values=[1e-2, 1e-3, 1e-4], tEnd=1.0)
 
 For each value, `sweep` resets YADE (``O.reset()``), calls ``build()``, sets

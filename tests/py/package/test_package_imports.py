@@ -8,7 +8,7 @@ import yade_dda
 
 PACKAGE = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', '..', 'py', 'yade_dda')
 COMPILED = ('_core',)   # the C++ module, built from pkg/dda: imports no Python sibling
-TOOLS = ('compare', 'accuracy', 'regression', 'compareColliders', 'sweep')
+TOOLS = ('compare', 'accuracy', 'regression', 'compareColliders', 'accuracySweep', 'sweep')
 
 
 def modules():
@@ -102,10 +102,22 @@ def test_import_star_exports_no_bench_tool():
 
 def test_bench_tools_stay_importable():
     from yade_dda import regression, compareColliders
-    assert callable(yade_dda.sweep) and callable(compareColliders)
+    assert callable(yade_dda.accuracySweep) and callable(compareColliders)
     assert yade_dda.compare.compareColliders is compareColliders
-    assert yade_dda.accuracy.sweep is yade_dda.sweep
+    assert yade_dda.accuracy.sweep is yade_dda.accuracySweep
     assert regression.__name__ == 'yade_dda.regression'
+
+
+def test_the_sweep_module_wins_over_the_accuracy_sweep():
+    """`yade_dda.sweep` is the module of `python3 -m yade_dda.sweep` (Dask), however it is
+    reached; the accuracy tool is `yade_dda.accuracy.sweep` (= `yade_dda.accuracySweep`)."""
+    import importlib
+    import types
+    from yade_dda import sweep
+    assert isinstance(sweep, types.ModuleType) and sweep.__name__ == 'yade_dda.sweep'
+    assert yade_dda.sweep is sweep is importlib.import_module('yade_dda.sweep')
+    assert callable(sweep.main) and callable(sweep.runRows)
+    assert yade_dda.accuracySweep is not sweep
 
 
 def test_install_hooks_is_idempotent():

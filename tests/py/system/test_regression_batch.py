@@ -1,6 +1,7 @@
 """Batch regressions (doc/user-guide.md, "Batch regressions"): the quick table through yade-batch and check.py.
 
-This is how CI runs the quick table. One yade-batch run (module fixture) of
+This is how CI runs the quick table. One yade-batch run (the fixture `batch` of
+tests/py/system/conftest.py, shared with test_sweep.py) of
 examples/regression/quick.table plus one row that crashes on purpose, with
 the yade_dda this test imports (the build tree under YADE_DDA_BUILD, else the
 installed package); then check.py on the records:
@@ -35,7 +36,6 @@ CHECK = os.path.join(REGRESSION, 'check.py')
 QUICK = os.path.join(REGRESSION, 'quick.table')
 FULL = os.path.join(REGRESSION, 'full.table')
 PYTHON = '/usr/bin/python3'
-CRASH_ROW = "crash-on-purpose  incline.py  2e-3  0.5  'DESS'  45  50  *   # a toppling cube: the scene refuses it\n"
 
 _spec = importlib.util.spec_from_file_location('regression_check', CHECK)
 check = importlib.util.module_from_spec(_spec)      # examples/regression/check.py, under its own name
@@ -51,26 +51,6 @@ def failed_scenes(output):
     line = [l for l in output.splitlines() if 'scenes failed:' in l][-1]
     names = line.split('scenes failed:')[1].split(';')[0].strip()
     return [] if names == 'none' else [n.strip() for n in names.split(',')]
-
-
-@pytest.fixture(scope='module')
-def batch(tmp_path_factory):
-    """yade-batch on the quick table plus CRASH_ROW; returns (table with the crash row, records dir)."""
-    work = tmp_path_factory.mktemp('regress')
-    table = work / 'quick+crash.table'
-    with open(QUICK) as f:
-        table.write_text(f.read() + CRASH_ROW)
-    records = work / 'records'
-    records.mkdir()
-    env = dict(os.environ)
-    package = os.path.dirname(os.path.dirname(os.path.abspath(yade_dda.__file__)))
-    env['PYTHONPATH'] = package + os.pathsep + env.get('PYTHONPATH', '')
-    env['YADE_DDA_RECORDS'] = str(records)
-    env.pop('YADE_BATCH', None)
-    with open(work / 'yade-batch.log', 'w') as log:
-        subprocess.run(['yade-batch', '-j', '2', '--disable-pynotify', '--log', str(records / '@.log'), str(table)],
-                       cwd=REGRESSION, env=env, stdout=log, stderr=subprocess.STDOUT, timeout=900)
-    return str(table), str(records)
 
 
 def test_quick_table_passes(batch):
