@@ -130,9 +130,35 @@ World::MemoryUse World::memoryUse() const {
 	return use;
 }
 
+namespace {
+// OpenMP's thread count (settings.threads) for the span of one step; the
+// calling thread's count before it is given back on leaving, by return or by
+// exception. The count is a setting of the calling thread that YADE's own
+// parallel loops read too, and YADE sizes a scene's ForceContainer by it when
+// the scene is made: a DDA step that set 1 in the main thread (O.step()) and
+// left it made the next scene's container one buffer wide, and YADE's
+// InteractionLoop, run with 2 threads, then wrote past it (a segfault in
+// ForceContainer::addForce of a mixed scene).
+class StepThreadCount {
+public:
+	explicit StepThreadCount(int threads) : previous_(omp_get_max_threads()), set_(threads > 0) {
+		if (set_) omp_set_num_threads(threads);
+	}
+	~StepThreadCount() {
+		if (set_) omp_set_num_threads(previous_);
+	}
+	StepThreadCount(const StepThreadCount&) = delete;
+	StepThreadCount& operator=(const StepThreadCount&) = delete;
+
+private:
+	int previous_;
+	bool set_;
+};
+}  // namespace
+
 double World::step(const IntegratorSettings& settings) {
 	validateSettings(settings);
-	if (settings.threads > 0) omp_set_num_threads(settings.threads);
+	const StepThreadCount threadCount(settings.threads);
 	if (steps_ == 0 && settings.startFromRest && !settleTried_) settle(settings);
 	settleTried_ = true;
 	const double dt = advance(settings);

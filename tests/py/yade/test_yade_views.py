@@ -232,3 +232,17 @@ def test_unbalanced_force_is_yades_with_ddas_gravity():
     assert ratios[-1] < 0.05
     import yade.utils
     assert yade.utils.unbalancedForce is hooks.unbalancedForce
+
+
+def test_a_dda_step_leaves_yades_thread_count_alone():
+    """A DDA step with threads=1 taken by O.step() (in the calling thread) once left OpenMP's thread
+    count at 1 there; O.reset() then made a scene whose ForceContainer YADE sized for one thread, and
+    YADE's InteractionLoop, run by O.run with the default two, wrote past it: a segfault in the mixed
+    scene below (it crashed the whole test run when an earlier test had stepped that way). The count a
+    step asks for holds for that step only."""
+    O.bodies.append(yade_dda.ddaBlock(box((0, 0, 0), (1, 1, 1)), material=material(O)))
+    O.engines = [yade_dda.DDAIntegrator(dt=1e-3, threads=1)]
+    O.step()
+    O.reset()
+    wall, sphere = _sphereOnWall(True)
+    assert _realPairs() == {(wall, sphere)}
