@@ -316,14 +316,21 @@ def test_core_load_state_is_all_or_nothing(scene):
     assert other.saveState() == good
 
 
-def test_load_of_a_corrupt_file_raises_and_puts_the_scene_back(scene, tmp_path):
+def _corruptFile(tmp_path):
+    """The saveload scene run 10 steps and saved by YADE's own save (which writes the tags as they
+    are) with its DDA state cut in half; the running scene keeps no state tag. Returns the path."""
     saveload_scene.build()
     O.run(10, True)
     text = _stored()
     O.tags[saveload.STATE_TAG] = text[:len(text) // 2]
     path = str(tmp_path / 'corrupt.yade')
-    wrapper.Omega.save._yadeDDA(O, path)   # YADE's own save: writes the tags as they are
+    wrapper.Omega.save._yadeDDA(O, path)
     O.tags[saveload.STATE_TAG] = ''
+    return path
+
+
+def test_load_of_a_corrupt_file_raises_and_puts_the_scene_back(scene, tmp_path):
+    path = _corruptFile(tmp_path)
     before = (O.iter, [tuple(yade_dda.block(i).vertices) for i in range(5)])
     with pytest.raises(ValueError, match='truncated or corrupt.*the running scene was put back as it was'):
         O.load(path)
@@ -333,12 +340,7 @@ def test_load_of_a_corrupt_file_raises_and_puts_the_scene_back(scene, tmp_path):
 
 def test_a_corrupt_state_loaded_into_an_empty_scene_stops_the_dda(scene, tmp_path):
     """With no running scene to put back, YADE's bodies stay loaded and DDA calls say why they cannot go on."""
-    saveload_scene.build()
-    O.run(10, True)
-    text = _stored()
-    O.tags[saveload.STATE_TAG] = text[:len(text) // 2]
-    path = str(tmp_path / 'corrupt.yade')
-    wrapper.Omega.save._yadeDDA(O, path)
+    path = _corruptFile(tmp_path)
     O.reset()
     with pytest.raises(ValueError, match='truncated or corrupt'):
         O.load(path)
