@@ -68,7 +68,7 @@ ROCK = dict(young=1e10, poisson=0.25, density=2600.0)
 PLAN = {
     'dt': dict(full=[1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2e-4, 1e-4], quick=[1e-2, 3e-3, 1e-3],
                scenes=['freefall', 'incline_smooth', 'incline_friction', 'wedge', 'bounce'], base={}),
-    'maxDisplacementRatio': dict(full=[0.03, 0.01, 3e-3, 1e-3, 3e-4, 1e-4], quick=[0.01, 1e-3],
+    'maxDisplacementRatio': dict(full=[0.18, 0.06, 0.018, 6e-3, 1.8e-3, 6e-4], quick=[0.06, 6e-3],
                                  scenes=['incline_friction', 'wedge', 'bounce'],
                                  base=dict(dt=1e-2, maxDisplacement=0.0)),
     'contactPenaltyFactor': dict(full=[1, 3, 10, 40, 100, 300, 1000], quick=[4, 40, 400],
