@@ -151,3 +151,27 @@ def test_hull_blocks_step(scene):
     O.engines = [yade_dda.DDAIntegrator(dt=1e-3, gravity=(0, 0, -9.81))]
     O.run(50, True)
     assert yade_dda.stats()['steps'] == 50
+
+
+def test_corners_yade_merges_are_dropped_near_the_size_limit(scene, monkeypatch):
+    """Clouds 9.9e3 m across, just inside ddaBlock's 1e4 m limit, where YADE's Polyhedra (absolute
+    tolerances) drops true corners of the hull: the block takes the hull of the corners YADE kept, so
+    the two agree, and its volume is at most the hull's. What that costs is stated, not hidden: the
+    volume lost (measured 0.5% at worst on these 20 clouds; 0 on the 100 ordinary ones above)."""
+    from yade_dda import blocks
+    taken = []
+    original = blocks._cornersYadeKept
+    monkeypatch.setattr(blocks, '_cornersYadeKept', lambda *a: taken.append(1) or original(*a))
+    rng = random.Random(SEED + 2)
+    worst = 0.0
+    for _ in range(20):
+        points = [tuple(9.9e3 * rng.random() for _ in range(3)) for _ in range(30)]
+        O.reset()
+        body, block = _append(points)
+        assert len(body.shape.v) == len(block.vertices)
+        expected = hullVolume(points)
+        assert block.volume <= expected * (1 + 1e-12)
+        worst = max(worst, (expected - block.volume) / expected)
+    print('YADE merged corners in %d of 20 clouds; worst volume lost %.2e' % (len(taken), worst))
+    assert taken, 'no cloud reached the path where YADE merges corners'
+    assert worst <= 0.01
