@@ -7,7 +7,8 @@ lines (continuation lines indented) that git apply skips:
 
     Removes:    the mechanism, in a few words (the table's column)
     Mechanism:  where it is and what it does
-    Tests:      the pytest node ids that must fail without it
+    Tests:      the tests that must fail without it: pytest node ids, or
+                `ctest:Suite.Name` for a GoogleTest case of dda_tests
     Why:        why those tests fail without it
 
 The name of a mutation is its file name without the leading number and
@@ -16,8 +17,10 @@ each mutation, the tracked and untracked (not ignored) files of this checkout
 are synchronised into <build-dir>/src (a file is rewritten only when its
 content differs, so the one build tree <build-dir>/build recompiles only what
 a mutation changed, and what the previous one changed back), the patch is
-applied with `git apply`, the Python module is built, and the named tests run
-against it (YADE_DDA_BUILD=<build-dir>/build/py, slow cases included). The
+applied with `git apply`, the Python module is built (and dda_tests when a
+`ctest:` case is named), and the named tests run against it
+(YADE_DDA_BUILD=<build-dir>/build/py, slow cases included; `ctest:` cases as
+`dda_tests --gtest_filter`). The
 unmutated tree must pass every named test; a mutation is caught when at least
 one of its tests fails (a crashed test run counts as a failure, a timeout or a
 skip does not).
@@ -118,11 +121,17 @@ def apply_patch(src, patch):
             raise SystemExit('%s does not apply to the current sources:\n%s' % (patch, e.stderr))
 
 
-def build(src, tree, jobs, log):
+CTEST = 'ctest:'
+"""Prefix of a GoogleTest case (`ctest:Suite.Name`) among a mutation's tests."""
+
+
+def build(src, tree, jobs, log, cpp=False):
+    """Builds the Python module, and dda_tests too when `cpp` (a `ctest:` case is named)."""
     if not os.path.exists(os.path.join(tree, 'CMakeCache.txt')):
         run_logged(['cmake', '-S', src, '-B', tree, '-DCMAKE_BUILD_TYPE=Release', '-DPYTHON_EXECUTABLE=' + PYTHON,
                     '-DPython3_EXECUTABLE=' + PYTHON], log)
-    run_logged(['cmake', '--build', tree, '-j', str(jobs), '--target', '_core', 'yade_dda_py'], log)
+    run_logged(['cmake', '--build', tree, '-j', str(jobs), '--target', '_core', 'yade_dda_py']
+               + (['dda_tests'] if cpp else []), log)
 
 
 def run_logged(cmd, log):
@@ -143,7 +152,60 @@ def junit_key(nodeid):
 
 
 def run_tests(src, tree, nodeids, xml, log, timeout):
-    """{node id: {outcome: passed|failed|crashed|skipped|timeout|not run, message}}."""
+    """{test id: {outcome: passed|failed|crashed|skipped|timeout|not run, message}}: the pytest
+    node ids through pytest, the `ctest:` cases through dda_tests."""
+    cases = [n for n in nodeids if n.startswith(CTEST)]
+    nodeids = [n for n in nodeids if not n.startswith(CTEST)]
+    out = run_gtest(tree, cases, xml[:-len('.xml')] + '-cpp.xml', log, timeout) if cases else {}
+    if nodeids:
+        out.update(run_pytest(src, tree, nodeids, xml, log, timeout))
+    return out
+
+
+def read_junit(xml):
+    """{(classname, name): {outcome, message}} of a JUnit XML file (pytest's and GoogleTest's)."""
+    results = {}
+    for case in ET.parse(xml).getroot().iter('testcase'):
+        key = (case.get('classname'), case.get('name'))
+        outcome, message = 'passed', ''
+        for child in case:
+            if child.tag in ('failure', 'error'):
+                outcome = 'failed'
+                message = (child.get('message') or child.text or '').strip()
+                break
+            if child.tag == 'skipped':
+                outcome, message = 'skipped', (child.get('message') or '').strip()
+        results[key] = dict(outcome=outcome, message=message)
+    return results
+
+
+def missing_result(code, timeout, runner):
+    if code is None:
+        return dict(outcome='timeout', message='no result within %d s' % timeout)
+    if code < 0:
+        return dict(outcome='crashed', message='the test process died with signal %d' % -code)
+    return dict(outcome='not run', message='%s ran no such test (exit %d)' % (runner, code))
+
+
+def run_gtest(tree, cases, xml, log, timeout):
+    """{`ctest:Suite.Name`: result} from one run of dda_tests on those cases."""
+    if os.path.exists(xml):
+        os.remove(xml)
+    names = [c[len(CTEST):] for c in cases]
+    cmd = [os.path.join(tree, 'dda_tests'), '--gtest_filter=' + ':'.join(names), '--gtest_output=xml:' + xml]
+    with open(log, 'a') as out:
+        out.write('$ %s\n' % ' '.join(cmd))
+        out.flush()
+        try:
+            code = subprocess.call(cmd, cwd=tree, stdout=out, stderr=subprocess.STDOUT, timeout=timeout)
+        except subprocess.TimeoutExpired:
+            code = None
+    results = read_junit(xml) if os.path.exists(xml) else {}
+    return {c: results.get(tuple(n.split('.', 1))) or missing_result(code, timeout, 'dda_tests')
+            for c, n in zip(cases, names)}
+
+
+def run_pytest(src, tree, nodeids, xml, log, timeout):
     if os.path.exists(xml):
         os.remove(xml)
     cmd = [PYTHON, '-m', 'pytest', '-q', '-p', 'no:cacheprovider', '-m', 'slow or not slow', '--junitxml=' + xml] \
@@ -156,41 +218,32 @@ def run_tests(src, tree, nodeids, xml, log, timeout):
             code = subprocess.call(cmd, cwd=src, env=env, stdout=out, stderr=subprocess.STDOUT, timeout=timeout)
         except subprocess.TimeoutExpired:
             code = None
-    results = {}
-    if os.path.exists(xml):
-        for case in ET.parse(xml).getroot().iter('testcase'):
-            key = (case.get('classname'), case.get('name'))
-            outcome, message = 'passed', ''
-            for child in case:
-                if child.tag in ('failure', 'error'):
-                    outcome = 'failed'
-                    message = (child.get('message') or child.text or '').strip()
-                    break
-                if child.tag == 'skipped':
-                    outcome, message = 'skipped', (child.get('message') or '').strip()
-            results[key] = dict(outcome=outcome, message=message)
-    out = {}
-    for nodeid in nodeids:
-        r = results.get(junit_key(nodeid))
-        if r is None:
-            if code is None:
-                r = dict(outcome='timeout', message='no result within %d s' % timeout)
-            elif code < 0:
-                r = dict(outcome='crashed', message='the test process died with signal %d' % -code)
-            else:
-                r = dict(outcome='not run', message='pytest ran no such test (exit %d)' % code)
-        out[nodeid] = r
-    return out
+    results = read_junit(xml) if os.path.exists(xml) else {}
+    return {n: results.get(junit_key(n)) or missing_result(code, timeout, 'pytest') for n in nodeids}
 
 
 def collected(nodeids):
-    """The subset of `nodeids` that `pytest --collect-only` finds in this checkout (slow cases
-    included), with the yade_dda that YADE_DDA_BUILD or the installed package gives."""
-    cmd = [PYTHON, '-m', 'pytest', '--collect-only', '-q', '-p', 'no:cacheprovider', '-m', 'slow or not slow'] \
-        + sorted({n.split('::', 1)[0] for n in nodeids})
-    out = subprocess.run(cmd, cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True).stdout
-    found = {line.strip() for line in out.splitlines()}
-    return {n for n in nodeids if n in found}
+    """The subset of `nodeids` that this checkout has: pytest ids that `pytest --collect-only`
+    finds (slow cases included, with the yade_dda that YADE_DDA_BUILD or the installed package
+    gives), `ctest:Suite.Name` cases defined by a TEST(Suite, Name) in tests/cpp."""
+    cases = {n for n in nodeids if n.startswith(CTEST)}
+    pytestIds = set(nodeids) - cases
+    found = set()
+    if pytestIds:
+        cmd = [PYTHON, '-m', 'pytest', '--collect-only', '-q', '-p', 'no:cacheprovider', '-m', 'slow or not slow'] \
+            + sorted({n.split('::', 1)[0] for n in pytestIds})
+        out = subprocess.run(cmd, cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True).stdout
+        lines = {line.strip() for line in out.splitlines()}
+        found |= {n for n in pytestIds if n in lines}
+    if cases:
+        defined = set()
+        for folder, _, files in os.walk(os.path.join(REPO, 'tests', 'cpp')):
+            for file in files:
+                if file.endswith('.cpp'):
+                    text = open(os.path.join(folder, file), encoding='utf-8').read()
+                    defined |= {'%s.%s' % m for m in re.findall(r'\bTEST(?:_F)?\(\s*(\w+)\s*,\s*(\w+)\s*\)', text)}
+        found |= {c for c in cases if c[len(CTEST):] in defined}
+    return found
 
 
 def list_mutations(chosen):
@@ -258,7 +311,7 @@ def main():
         sync_sources(src)
         if patch:
             apply_patch(src, patch)
-        build(src, tree, args.jobs, log)
+        build(src, tree, args.jobs, log, cpp=any(n.startswith(CTEST) for n in nodeids))
         t1 = time.time()
         results = run_tests(src, tree, nodeids, os.path.join(logs, name + '.xml'), log, args.timeout)
         t2 = time.time()
