@@ -8,6 +8,7 @@ velocity and, for strained blocks, the local vertices of the Polyhedra shape).
 One core scene belongs to one YADE scene. It is found through a token stored in
 ``O.tags``, so ``O.reset()`` (which clears the tags) starts a fresh DDA scene.
 """
+import gc
 import time
 import uuid
 
@@ -75,7 +76,21 @@ class DDAScene:
         return index
 
     def sync(self, everything=False):
-        """Writes the core state of moving blocks (all blocks if everything) into YADE's bodies."""
+        """Writes the core state of moving blocks (all blocks if everything) into YADE's bodies.
+
+        Python's cyclic garbage collector is paused meanwhile (and put back as it was): the sync makes
+        a few container objects per block (tuples of YADE vectors), none in a cycle, so the
+        collector's passes that their allocations trigger free nothing; they took two thirds of the
+        sync of 10,000 cubes (189 ms with them, 67 ms without, issue 21)."""
+        running = gc.isenabled()
+        gc.disable()
+        try:
+            self._sync(everything)
+        finally:
+            if running:
+                gc.enable()
+
+    def _sync(self, everything):
         start = time.perf_counter()
         bodies = O.bodies
         data = self.core.syncData(everything)
