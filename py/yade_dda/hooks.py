@@ -66,6 +66,11 @@ def _wrapReplace(original):
 
 # ------------------------------------------------------------------ Omega
 
+def _fileArgument(args, kwargs):
+    """The file name given to O.save or O.load (their first argument, or `file`)."""
+    return args[0] if args else kwargs.get('file')
+
+
 def _checkSavePath(path):
     """Refuses, before YADE writes anything, a file name that YADE would silently not write."""
     if not isinstance(path, str) or not path:
@@ -83,8 +88,9 @@ def _wrapSave(original):
     toFile = original.__name__ == 'save'
 
     def save(self, *args, **kwargs):
+        path = _fileArgument(args, kwargs) if toFile else None
         if toFile:
-            _checkSavePath(args[0] if args else kwargs.get('file'))
+            _checkSavePath(path)
         stored = _saveload.storeState()
         try:
             result = original(self, *args, **kwargs)
@@ -92,7 +98,6 @@ def _wrapSave(original):
             if stored:
                 O.tags[_saveload.STATE_TAG] = ''
         if toFile:
-            path = args[0] if args else kwargs.get('file')
             if not os.path.isfile(path) or os.path.getsize(path) == 0:
                 raise OSError('O.save(%r): YADE wrote nothing' % (path,))
         return result
@@ -115,7 +120,7 @@ def _wrapLoad(original):
 
     def load(self, *args, **kwargs):
         if fromFile:
-            _checkLoadPath(args[0] if args else kwargs.get('file'))
+            _checkLoadPath(_fileArgument(args, kwargs))
         before = _saveload.currentToken()
         # YADE empties the running scene when a load fails half-way: keep a copy to put back.
         keep = _keepScene(self)
