@@ -21,16 +21,12 @@
 // fixed-point springs): everything but gravity and inertia, as O.forces holds
 // for YADE's bodies (NewtonIntegrator adds gravity itself). Its torque is
 // taken about its centroid.
-#include "SceneLink.hpp"
+#include "YadeSync.hpp"
 #include "dda/solver/BlockEquations.hpp"
-
-#include <boost/python.hpp>
 
 #include <algorithm>
 #include <map>
 #include <utility>
-
-namespace py = boost::python;
 
 namespace dda {
 
@@ -46,16 +42,11 @@ struct PairSum {
 	int count = 0;
 };
 
-}  // namespace
-
-// (pairs, bodies): pairs as (id1, id2, contactPoint, normal, normalForce,
-// shearForce, kn, ks, tanPhi), id1 < id2, in that order; bodies as (id,
-// force, torque) for every block linked to a body, in block order.
-py::tuple viewData(const SceneLink& s, const IntegratorSettings& settings) {
+// The forces on block i from its closed contacts [N], their torques about
+// its centroid [N m], and the body pairs' sums; both in one pass.
+void contactSums(const SceneLink& s, std::vector<Vector3>* force, std::vector<Vector3>* torque,
+                 std::map<std::pair<int, int>, PairSum>* pairs) {
 	const World& w = s.world;
-	const int n = w.blockCount();
-	std::vector<Vector3> force(n, Vector3::Zero()), torque(n, Vector3::Zero());
-	std::map<std::pair<int, int>, PairSum> pairs;
 	for (const Contact& c : w.contacts()) {
 		if (c.history.state == ContactState::Open) continue;
 		const int i = c.key.blockI, j = c.key.blockJ;
@@ -63,16 +54,19 @@ py::tuple viewData(const SceneLink& s, const IntegratorSettings& settings) {
 		const BodyLink* lj = s.bodyLink(j);
 		if (!li || !lj) continue;
 		const Vector3 onI = c.geometry.normal * c.history.normalForce + c.history.shearForce;
-		force[i] += onI;
-		force[j] -= onI;
-		torque[i] += (c.point - w.block(i).centroid).cross(onI);
-		torque[j] -= (c.point - w.block(j).centroid).cross(onI);
+		if (force) {
+			(*force)[i] += onI;
+			(*force)[j] -= onI;
+			(*torque)[i] += (c.point - w.block(i).centroid).cross(onI);
+			(*torque)[j] -= (c.point - w.block(j).centroid).cross(onI);
+		}
+		if (!pairs) continue;
 		// Body order: id1 is the smaller body id. The normal n_k points from j
 		// to i: from id1 to id2 when i is id2.
 		const bool iIsSecond = li->bodyId > lj->bodyId;
 		const std::pair<int, int> key = iIsSecond ? std::make_pair(lj->bodyId, li->bodyId)
 		                                          : std::make_pair(li->bodyId, lj->bodyId);
-		PairSum& p = pairs[key];
+		PairSum& p = (*pairs)[key];
 		const Vector3 normal12 = iIsSecond ? c.geometry.normal : Vector3(-c.geometry.normal);
 		p.weightedNormal += std::max(c.history.normalForce, 0.0) * normal12;
 		p.plainNormal += normal12;
@@ -86,16 +80,33 @@ py::tuple viewData(const SceneLink& s, const IntegratorSettings& settings) {
 		p.tanPhi = std::max(p.tanPhi, c.frictionTangent);
 		++p.count;
 	}
-	py::list pairList;
+}
+
+}  // namespace
+
+std::vector<PairView> pairViews(const SceneLink& s) {
+	std::map<std::pair<int, int>, PairSum> pairs;
+	contactSums(s, nullptr, nullptr, &pairs);
+	std::vector<PairView> out;
+	out.reserve(pairs.size());
 	for (const auto& [ids, p] : pairs) {
 		const Vector3 sum = p.weightedNormal.squaredNorm() > 0 ? p.weightedNormal : p.plainNormal;
 		const Vector3 normal = sum.squaredNorm() > 0 ? Vector3(sum.normalized()) : Vector3(Vector3::UnitZ());
 		const Vector3 normalForce = p.force.dot(normal) * normal;
 		const Vector3 point = p.weight > 0 ? Vector3(p.weightedPoint / p.weight) : Vector3(p.plainPoint / p.count);
-		pairList.append(py::make_tuple(ids.first, ids.second, point, normal, normalForce, Vector3(p.force - normalForce),
-		                               p.kn, p.ks, p.tanPhi));
+		out.push_back(PairView{ids.first, ids.second, point, normal, normalForce, Vector3(p.force - normalForce), p.kn,
+		                       p.ks, p.tanPhi});
 	}
-	py::list bodyList;
+	return out;
+}
+
+std::vector<BodyForce> bodyForces(const SceneLink& s, const IntegratorSettings& settings) {
+	const World& w = s.world;
+	const int n = w.blockCount();
+	std::vector<Vector3> force(n, Vector3::Zero()), torque(n, Vector3::Zero());
+	contactSums(s, &force, &torque, nullptr);
+	std::vector<BodyForce> out;
+	out.reserve(n);
 	for (int i = 0; i < n; ++i) {
 		const BodyLink* link = s.bodyLink(i);
 		if (!link) continue;
@@ -110,9 +121,9 @@ py::tuple viewData(const SceneLink& s, const IntegratorSettings& settings) {
 			f += spring;
 			m += (point.position - b.centroid).cross(spring);
 		}
-		bodyList.append(py::make_tuple(link->bodyId, f, m));
+		out.push_back(BodyForce{link->bodyId, f, m});
 	}
-	return py::make_tuple(pairList, bodyList);
+	return out;
 }
 
 }  // namespace dda

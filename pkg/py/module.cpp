@@ -7,6 +7,7 @@
 // dda::InputError (a std::invalid_argument) -> ValueError, std::out_of_range ->
 // IndexError, anything else -> RuntimeError.
 #include "SceneLink.hpp"
+#include "YadeSync.hpp"
 #include "dda/collider/ColliderFactory.hpp"
 #include "dda/solver/InitialOverlaps.hpp"
 
@@ -14,11 +15,6 @@
 
 namespace py = boost::python;
 using namespace dda;
-
-namespace dda {
-// Views.cpp: per block pair and per block, what YADE's interactions and forces show.
-py::tuple viewData(const SceneLink& s, const IntegratorSettings& settings);
-}  // namespace dda
 
 namespace {
 
@@ -155,31 +151,6 @@ double step(SceneLink& s, const IntegratorSettings& settings) {
 		PyEval_RestoreThread(state);
 	}
 	return dt;
-}
-
-// Per moving block linked to a body (and fixed ones once): (bodyId, pos, ori, vel, angVel, vertices or None).
-// Vertices are in the body's local frame, in the body's vertex order, and are
-// sent at a block's first sync (YADE's frame is at YADE's centroid, the sync's
-// at the core's: they differ by round-off) and then only when the block's
-// strain changed since the last sync.
-py::list syncData(SceneLink& s, bool all) {
-	py::list out;
-	for (int i = 0; i < s.world.blockCount(); ++i) {
-		Block& b = s.world.block(i);
-		BodyLink* link = s.bodyLink(i);
-		if (!link || (b.fixed && link->synced && !all)) continue;
-		const bool first = !link->synced;
-		link->synced = true;
-		const Eigen::Quaterniond ori = s.bodyOrientation(i);
-		py::object vertices;
-		if (all || first || b.unsyncedStrain > SceneLink::kVertexSyncStrain) {
-			vertices = toList(s.localVertices(i));
-			b.unsyncedStrain = 0;
-		}
-		out.append(py::make_tuple(link->bodyId, b.centroid, ori, Vector3(b.velocity.head<3>()),
-		                          Vector3(b.velocity.segment<3>(3)), vertices));
-	}
-	return out;
 }
 
 // The gap at the start of the step [m] of each sub-contact of the last step,
@@ -484,11 +455,6 @@ BOOST_PYTHON_MODULE(_core) {
 	    .def("setVelocity", &setVelocity)
 	    .def("setStress", &setStress)
 	    .def("step", &step)
-	    .def("syncData", &syncData)
-	    .def("viewData", &dda::viewData, (py::arg("settings")),
-	         "(pairs, bodies) for yade_dda.views: per body pair with a closed contact (id1 < id2, contactPoint, normal "
-	         "from id1 to id2, normalForce and shearForce on id2 [N], kn, ks [N/m], tanPhi); per linked block (body "
-	         "id, force [N], torque about its centroid [N m]), gravity excluded (pkg/py/Views.cpp).")
 	    .def("lastStep", &lastStep)
 	    .def("motionHalfSize", &SceneLink::motionHalfSize)
 	    .def("time", &SceneLink::time)
@@ -496,4 +462,34 @@ BOOST_PYTHON_MODULE(_core) {
 	    .def("saveState", &saveState, "The whole DDA scene (blocks, contacts and their history, counters) as bytes.")
 	    .def("loadState", &loadState,
 	         "Replaces this scene by a state from saveState; ValueError naming the problem (and no change) if it cannot.");
+
+	py::class_<YadeSync, boost::noncopyable>(
+	    "YadeSync",
+	    "Writes a Scene's state into YADE's containers from C++ (pkg/py/YadeSync.hpp): body states and shapes, "
+	    "O.forces, O.interactions. One per DDA scene; it keeps YADE's objects it wrote to.",
+	    py::init<py::object, py::object, py::object>(
+	        (py::arg("geomClass"), py::arg("physClass"), py::arg("createInteraction"))))
+	    .def("writeBodies", &YadeSync::writeBodies, (py::arg("scene"), py::arg("bodies"), py::arg("all")),
+	         "Writes moving blocks' (every block's if all) pos, ori, vel, angVel and, when strained, vertices into "
+	         "their bodies (bodies: O.bodies); returns how many.")
+	    .def("writeForces", &YadeSync::writeForces, (py::arg("scene"), py::arg("settings"), py::arg("forces")),
+	         "Makes O.forces (forces) hold each block's force [N] and torque about its centroid [N m], gravity "
+	         "excluded.")
+	    .def("writeInteractions", &YadeSync::writeInteractions,
+	         (py::arg("scene"), py::arg("interactions"), py::arg("keep"), py::arg("foreign")),
+	         "Makes O.interactions hold a real interaction per body pair with a closed contact (none unless keep); "
+	         "foreign: [(id1, id2)] DDA pairs already there that it did not make. Returns the pair count.")
+	    .def("forgetBodies", &YadeSync::forgetBodies, "A body's state or shape object was replaced.")
+	    .def("forgetInteractions", &YadeSync::forgetInteractions, "A script cleared O.interactions.")
+	    .def("forgetInteraction", &YadeSync::forgetInteraction, (py::arg("id1"), py::arg("id2")),
+	         "A script erased this interaction.")
+	    .def("counters", +[](const YadeSync& y) {
+		    const YadeSync::Counters c = y.counters();
+		    py::dict out;
+		    out["bodiesKept"] = c.bodiesKept;
+		    out["interactionsKept"] = c.interactionsKept;
+		    out["forceReadBacks"] = c.forceReadBacks;
+		    return out;
+	    }, "bodiesKept, interactionsKept: blocks and pairs whose YADE objects are kept; forceReadBacks: syncs "
+	       "that read O.forces back because its probe disagreed.");
 }

@@ -1,7 +1,7 @@
 """The one place where yade_dda changes YADE's own classes: ``installHooks``.
 
 YADE knows nothing of the DDA core, which holds the true state of every DDA
-block. Two of YADE's classes are wrapped so that what a script does to the
+block. Four of YADE's classes are wrapped so that what a script does to the
 YADE scene reaches the core too; each wrapper calls YADE's original method
 (kept as the wrapper's ``_yadeDDA`` attribute) and adds the DDA part.
 """
@@ -62,6 +62,55 @@ def _wrapReplace(original):
     replace.__doc__ = original.__doc__
     replace._yadeDDA = original
     return replace
+
+
+class _WrappedProperty(property):
+    """A YADE property with a yade_dda setter; ``yadeOriginal`` is YADE's property."""
+    yadeOriginal = None
+
+
+def _yadeProperty(cls, name):
+    current = cls.__dict__[name]
+    return getattr(current, 'yadeOriginal', None) or current
+
+
+def _wrapBodyObject(original):
+    """Body.state and Body.shape: YADE's setter, then the scene's C++ writer, which keeps the State
+    and Polyhedra objects of DDA bodies it wrote to, forgets them (pkg/py/YadeSync.hpp)."""
+    def assign(self, value):
+        original.fset(self, value)
+        writer = _scene.writerOfCurrent()
+        if writer is not None:
+            writer.forgetBodies()
+    wrapped = _WrappedProperty(original.fget, assign, None, original.__doc__)
+    wrapped.yadeOriginal = original
+    return wrapped
+
+
+# ------------------------------------------------------------------ InteractionContainer
+
+def _wrapInteractionErase(original):
+    def erase(self, id1, id2, *args, **kw):
+        result = original(self, id1, id2, *args, **kw)
+        writer = _scene.writerOfCurrent()
+        if writer is not None:
+            writer.forgetInteraction(id1, id2)
+        return result
+    erase.__doc__ = original.__doc__
+    erase._yadeDDA = original
+    return erase
+
+
+def _wrapInteractionClear(original):
+    def clear(self, *args, **kw):
+        result = original(self, *args, **kw)
+        writer = _scene.writerOfCurrent()
+        if writer is not None:
+            writer.forgetInteractions()
+        return result
+    clear.__doc__ = original.__doc__
+    clear._yadeDDA = original
+    return clear
 
 
 # ------------------------------------------------------------------ Omega
@@ -180,8 +229,7 @@ class _DtProperty(property):
 
 
 def _yadeDt():
-    current = wrapper.Omega.__dict__['dt']
-    return getattr(current, 'yadeOriginal', None) or current
+    return _yadeProperty(wrapper.Omega, 'dt')
 
 
 def writeDt(value):
@@ -278,6 +326,10 @@ def installHooks():
       (saveload.afterLoad); a load that fails puts the running scene back.
       ``Omega.save`` refuses a path it cannot write; ``Omega.load`` a name
       that is no file.
+    - ``InteractionContainer.erase`` and ``clear`` (``O.interactions``), and
+      the ``Body.state`` and ``Body.shape`` setters: YADE's own, then the
+      scene's C++ writer forgets the YADE objects it kept that they replaced
+      or removed (pkg/py/YadeSync.hpp).
     - ``Omega.dt``: a time step the script assigns is noted in ``O.tags``
       (USER_DT_TAG), and checked (finite, > 0) in a scene with DDA blocks;
       the integrator's next step makes it ``DDAIntegrator.dt``, its largest
@@ -290,9 +342,13 @@ def installHooks():
     for cls, names, wrap in ((wrapper.BodyContainer, ('erase',), _wrapErase),
                              (wrapper.BodyContainer, ('clear',), _wrapClear),
                              (wrapper.BodyContainer, ('replace',), _wrapReplace),
+                             (wrapper.InteractionContainer, ('erase',), _wrapInteractionErase),
+                             (wrapper.InteractionContainer, ('clear',), _wrapInteractionClear),
                              (wrapper.Omega, _OMEGA_SAVES, _wrapSave),
                              (wrapper.Omega, _OMEGA_LOADS, _wrapLoad)):
         for name in names:
             setattr(cls, name, wrap(_original(cls, name)))
     wrapper.Omega.dt = _wrapDt(_yadeDt())
+    for name in ('state', 'shape'):
+        setattr(wrapper.Body, name, _wrapBodyObject(_yadeProperty(wrapper.Body, name)))
     _installUnbalancedForce()

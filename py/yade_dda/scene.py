@@ -8,11 +8,10 @@ velocity and, for strained blocks, the local vertices of the Polyhedra shape).
 One core scene belongs to one YADE scene. It is found through a token stored in
 ``O.tags``, so ``O.reset()`` (which clears the tags) starts a fresh DDA scene.
 """
-import gc
 import time
 import uuid
 
-from ._yade import O, wrapper
+from ._yade import O, wrapper, utils
 from . import _core
 from . import state as _state
 from . import views as _views
@@ -30,6 +29,9 @@ class DDAScene:
         self.pending = []          # [(body, BlockSpec)] made by ddaBlock, not yet in the core
         self.bodyOfBlock = []      # block index -> body id
         self.syncTime = 0.0        # wall time of the last sync [s]
+        self.syncParts = dict(bodies=0.0, views=0.0)   # its parts [s]: bodies, and views.update
+        self.yadeSync = None       # _core.YadeSync, made by writer()
+        self.viewsStarted = False  # views.update has run (it looked for a loaded scene's DDA interactions)
         self.syncedBodies = 0
         self.syncs = 0             # number of syncs done
         self.syncTimeTotal = 0.0   # wall time of all syncs [s]
@@ -75,41 +77,28 @@ class DDAScene:
             raise KeyError('body %d is not a DDA block (unknown body id, or not yet appended to O.bodies)' % bodyId)
         return index
 
+    def writer(self):
+        """The scene's C++ writer into YADE's containers (_core.YadeSync, pkg/py/YadeSync.hpp), made on first use."""
+        if self.yadeSync is None:
+            self.yadeSync = _core.YadeSync(wrapper.PolyhedraGeom, wrapper.PolyhedraPhys, utils.createInteraction)
+        return self.yadeSync
+
     def sync(self, everything=False):
-        """Writes the core state of moving blocks (all blocks if everything) into YADE's bodies.
+        """Writes the core state of moving blocks (all blocks if everything) into YADE's bodies, and
+        the views of views.py (O.interactions, O.forces, O.energy).
 
-        Python's cyclic garbage collector is paused meanwhile (and put back as it was): the sync makes
-        a few container objects per block (tuples of YADE vectors), none in a cycle, so the
-        collector's passes that their allocations trigger free nothing; they took two thirds of the
-        sync of 10,000 cubes (189 ms with them, 67 ms without, issue 21)."""
-        running = gc.isenabled()
-        gc.disable()
-        try:
-            self._sync(everything)
-        finally:
-            if running:
-                gc.enable()
-
-    def _sync(self, everything):
+        The writes are made in C++ (pkg/py/YadeSync.cpp) through YADE's own attributes, with the
+        YADE objects looked up once and kept, and no Python object made per block: nothing for
+        Python's garbage collector (the Python loop this replaced made a tuple of vectors per block,
+        and the collector's passes took two thirds of its time at 10,000 blocks)."""
         start = time.perf_counter()
-        bodies = O.bodies
-        data = self.core.syncData(everything)
-        for bodyId, pos, ori, vel, angVel, vertices in data:
-            body = bodies[bodyId]
-            if body is None:
-                raise RuntimeError('body %d of a DDA block was removed from O.bodies; '
-                                   'removing DDA blocks mid-run is not supported' % bodyId)
-            state = body.state
-            state.pos = pos
-            state.ori = ori
-            state.vel = vel
-            state.angVel = angVel
-            if vertices is not None:
-                body.shape.v = vertices
-        _views.update(self)   # O.interactions, O.forces, O.energy (views.py)
-        self.syncTime = time.perf_counter() - start
+        self.syncedBodies = self.writer().writeBodies(self.core, O.bodies, everything)
+        middle = time.perf_counter()
+        _views.update(self)
+        end = time.perf_counter()
+        self.syncTime = end - start
+        self.syncParts = dict(bodies=middle - start, views=end - middle)
         self.syncTimeTotal += self.syncTime
-        self.syncedBodies = len(data)
         self.syncs += 1
 
 
@@ -135,6 +124,14 @@ def _bodyId(body):
     if not isinstance(bodyId, int):
         raise TypeError('expected a YADE Body or a body id (int), got %r' % (body,))
     return bodyId
+
+
+def writerOfCurrent():
+    """The C++ writer (YadeSync) of the current YADE scene's DDA scene, or None when there is none
+    yet; never restores or makes a scene (what yade_dda.hooks needs to tell it what a script did)."""
+    token = O.tags[TAG] if TAG in O.tags.keys() else None
+    scene = _scenes.get(token) if token else None
+    return scene.yadeSync if scene is not None else None
 
 
 def current(create=True):
@@ -293,7 +290,8 @@ def stats():
     the step, ``solver`` (per moving block its solution and motion, the
     systems of the blocks with springs, the coupled system's blocks).
     ``time``: wall seconds per phase: broadPhase, narrowPhase, assembly,
-    solve, update, core, sync. ``cpuTime``: the process's CPU seconds (all
+    solve, update, core, sync (of which syncBodies: the bodies, and syncViews:
+    interactions, forces and energy; views.py). ``cpuTime``: the process's CPU seconds (all
     threads) in broadPhase and narrowPhase; with one thread it is the work
     without the machine's waits, steadier than wall time on a busy machine.
     ``syncedBodies`` and ``syncs``
@@ -315,6 +313,8 @@ def stats():
     scene = _require()
     result = scene.core.lastStep()
     result['time']['sync'] = scene.syncTime
+    result['time']['syncBodies'] = scene.syncParts['bodies']
+    result['time']['syncViews'] = scene.syncParts['views']
     result['syncedBodies'] = scene.syncedBodies
     result['syncs'] = scene.syncs
     result['syncTimeTotal'] = scene.syncTimeTotal

@@ -30,7 +30,7 @@ bodies: only when something may read them.
   account (``stats()['energy']``) under ENERGY_NAMES, signed so that
   ``O.energy.total()`` is the conserved balance.
 """
-from ._yade import O, wrapper, utils
+from ._yade import O, wrapper
 from . import _core
 
 ENERGY_NAMES = (
@@ -59,39 +59,23 @@ def setEnabled(flag):
 
 def update(scene, engines=None):
     """Writes the DDA scene's interactions, forces and energy into YADE's
-    containers (called by DDAScene.sync)."""
+    containers (called by DDAScene.sync); the writes are made in C++
+    (pkg/py/YadeSync.hpp: what it keeps of YADE's objects, and why that holds)."""
     if not _enabled:
         return
     settings = getattr(scene, 'settings', None) or _DEFAULT_SETTINGS
-    pairs, bodies = scene.core.viewData(settings)
-    _writeForces(bodies)
+    writer = scene.writer()
+    # O.forces: YADE resets it only where a ForceResetter runs (a DDA scene need not have one), so the
+    # writer adds what is missing; see YadeSync::writeForces for how it knows what is there.
+    writer.writeForces(scene.core, settings, O.forces)
     engines = O.engines if engines is None else engines
-    _writeInteractions(scene, pairs, not any(_isLiveLoop(e) for e in engines))
+    keep = not any(_isLiveLoop(e) for e in engines)
+    # The first update of a scene also erases DDA interactions it did not make (a loaded scene's).
+    foreign = [] if scene.viewsStarted else sorted(_ddaPairs(scene))
+    writer.writeInteractions(scene.core, O.interactions, keep, foreign)
+    scene.viewsStarted = True
     if O.trackEnergy:
         _writeEnergy(scene)
-
-
-def _writeForces(bodies):
-    """Makes O.forces hold each block's (force, torque). addF adds, and YADE resets O.forces only
-    where a ForceResetter runs (a DDA scene need not have one): what is missing is added. YADE's
-    container (OpenMP build) sums per-thread buffers when synced, and f(id) without a sync after an
-    addF reads only part of them: all are read synced first, then added to, then synced again."""
-    if not bodies:
-        return
-    forces = O.forces
-    first = bodies[0][0]
-    forces.f(first, True)   # sync
-    current = [(forces.f(bodyId), forces.t(bodyId)) for bodyId, _, _ in bodies]
-    changed = False
-    for (bodyId, force, torque), (f, t) in zip(bodies, current):
-        if f != force:
-            forces.addF(bodyId, force - f)
-            changed = True
-        if t != torque:
-            forces.addT(bodyId, torque - t)
-            changed = True
-    if changed:
-        forces.f(first, True)   # sync: f(id) reads the sums
 
 
 def _isLiveLoop(engine):
@@ -103,40 +87,6 @@ def _ddaPairs(scene):
     a loaded scene brought along)."""
     blocks = set(scene.bodyOfBlock)
     return {(i.id1, i.id2) for i in O.interactions if i.id1 in blocks and i.id2 in blocks}
-
-
-def _writeInteractions(scene, pairs, keep):
-    intrs = O.interactions
-    previous = getattr(scene, 'viewPairs', None)
-    if previous is None:
-        previous = _ddaPairs(scene)
-    current = set()
-    if keep:
-        Geom, Phys = wrapper.PolyhedraGeom, wrapper.PolyhedraPhys
-        for id1, id2, point, normal, normalForce, shearForce, kn, ks, tanPhi in pairs:
-            current.add((id1, id2))
-            try:
-                i = intrs[id1, id2]
-            except IndexError:
-                i = utils.createInteraction(id1, id2, True)   # virtual: no functor runs
-            geom, phys = i.geom, i.phys
-            if not isinstance(geom, Geom):
-                geom = i.geom = Geom()
-            if not isinstance(phys, Phys):
-                phys = i.phys = Phys()
-            geom.contactPoint = point
-            geom.normal = normal
-            phys.normalForce = normalForce
-            phys.shearForce = shearForce
-            phys.kn = kn
-            phys.ks = ks
-            phys.tangensOfFrictionAngle = tanPhi
-    gone = [pair for pair in previous - current if intrs.has(*pair)]
-    for id1, id2 in gone:
-        intrs.erase(id1, id2)   # YADE's erase leaves a virtual interaction for a collider to remove...
-    if gone and keep:
-        intrs.eraseNonReal()    # ... there is none that would (no live InteractionLoop): remove them here
-    scene.viewPairs = current
 
 
 def _writeEnergy(scene):

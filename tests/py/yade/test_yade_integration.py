@@ -159,20 +159,3 @@ def test_script_helpers_change_a_running_block(scene):
     assert abs(O.bodies[body].state.pos[2] - (z0 + 0.5 * (O.time - t0) ** 2)) < 1e-12
     with pytest.raises(ValueError, match='finite'):
         yade_dda.addPointLoad(body, (0, 0, float('nan')), (0, 0, 1))
-
-
-def test_sync_puts_the_garbage_collector_back(scene):
-    """The sync pauses Python's cyclic collector (its passes freed nothing and took two thirds of a
-    10,000-block sync) and leaves it as it found it, on or off."""
-    import gc
-    O.bodies.append(yade_dda.ddaBlock(box((0, 0, 0), (1, 1, 1))))
-    O.engines = [yade_dda.DDAIntegrator(dt=1e-3, gravity=(0, 0, -9.81))]
-    assert gc.isenabled()
-    O.run(2, True)
-    assert gc.isenabled() and yade_dda.stats()['syncs'] >= 1
-    gc.disable()
-    try:
-        O.run(2, True)
-        assert not gc.isenabled()
-    finally:
-        gc.enable()

@@ -1,0 +1,115 @@
+// Writes the DDA state into YADE's containers from C++ (the sync of
+// yade_dda.scene): body states and deformed shapes, O.forces, and the real
+// interactions of O.interactions (what Views.cpp computes).
+//
+// Every write goes through YADE's own Python attributes (YADE ships no
+// headers, DESIGN.md), but from a C++ loop, without Python objects made per
+// block: the State, Polyhedra, PolyhedraGeom and PolyhedraPhys objects are
+// looked up once and kept, and the vectors handed to YADE's setters are a few
+// Python Vector3/Quaternion objects refilled in place (a setter copies the
+// value). The caches hold because:
+//   - YADE's bodies of DDA blocks stay while the scene lives: erasing a block
+//     is refused, clear/replace/O.load/O.reset give a new DDA scene and with
+//     it a new YadeSync (yade_dda.hooks);
+//   - a script that replaces a block's state or shape object (Body.state and
+//     Body.shape setters) or erases or clears interactions goes through
+//     yade_dda.hooks, which tells this object to forget what it kept;
+//   - the interactions are real ones (geom and phys set), which YADE's
+//     colliders never erase, and none are kept while a YADE InteractionLoop
+//     runs (views.py).
+// O.forces: forceWrites adds to each block's force the difference between the
+// new value and what this object last wrote; one probe (a block whose force
+// it believes nonzero) checks that nobody reset or changed them since. On a
+// mismatch (a ForceResetter ran, O.forces.reset(), permanent forces) every
+// block's force is read back and the difference added, as the Python sync
+// did. See doc/user-guide.md, "What YADE sees".
+#pragma once
+
+#include "SceneLink.hpp"
+#include "dda/solver/IntegratorSettings.hpp"
+
+#include <boost/python.hpp>
+
+#include <map>
+#include <utility>
+#include <vector>
+
+namespace dda {
+
+namespace py = boost::python;
+
+// One body pair with a closed DDA contact, as YADE's PolyhedraGeom and
+// PolyhedraPhys show it (Views.cpp): id1 < id2; normal from id1 to id2;
+// normalForce + shearForce is the force on id2 [N].
+struct PairView {
+	int id1, id2;
+	Vector3 point, normal, normalForce, shearForce;
+	double kn, ks, tanPhi;  // [N/m], [N/m], [-]
+};
+
+// A block's force [N] and torque about its centroid [N m], gravity excluded.
+struct BodyForce {
+	int bodyId;
+	Vector3 force, torque;
+};
+
+// Views.cpp: the pairs in body order, and one entry per linked block in block order.
+std::vector<PairView> pairViews(const SceneLink& s);
+std::vector<BodyForce> bodyForces(const SceneLink& s, const IntegratorSettings& settings);
+
+class YadeSync {
+public:
+	// geomClass, physClass: YADE's PolyhedraGeom and PolyhedraPhys;
+	// createInteraction: utils.createInteraction.
+	YadeSync(py::object geomClass, py::object physClass, py::object createInteraction);
+
+	// Moving blocks' (every block's if all) position, orientation, velocity,
+	// angular velocity, and vertices when strained since the last write;
+	// returns how many bodies were written.
+	int writeBodies(SceneLink& s, const py::object& bodies, bool all);
+	// O.forces holds bodyForces (forces: O.forces).
+	void writeForces(const SceneLink& s, const IntegratorSettings& settings, const py::object& forces);
+	// O.interactions holds pairViews when keep (else none of them);
+	// foreign: DDA pairs already in O.interactions that this object did not
+	// make (a loaded scene's), erased unless current. Returns the pair count.
+	int writeInteractions(const SceneLink& s, const py::object& interactions, bool keep, const py::list& foreign);
+
+	void forgetBodies();        // a body's state or shape object was replaced
+	void forgetInteractions();                 // a script cleared the interactions
+	void forgetInteraction(int id1, int id2);  // a script erased one
+	struct Counters {
+		int bodiesKept, interactionsKept;  // whose YADE objects are kept
+		long forceReadBacks;               // syncs that read O.forces back (a probe disagreed)
+	};
+	Counters counters() const;
+
+private:
+	struct BodyObjects {
+		py::object state, shape;  // None until looked up
+	};
+	struct PairObjects {
+		py::object geom, phys;
+	};
+	BodyObjects& bodyObjects(const py::object& bodies, int block, int bodyId);
+	PairObjects pairObjects(const py::object& interactions, int id1, int id2);
+	struct VertexList {
+		py::object list;               // of `count` Vector3 objects...
+		std::vector<Vector3*> values;  // ... and their values, refilled before each write
+	};
+	const VertexList& vertexList(std::size_t count);
+	void setVector(PyObject* target, PyObject* name, const Vector3& value);
+	void addForces(const std::vector<BodyForce>& target, const py::object& forces, bool readBack);
+
+	py::object geomClass_, physClass_, createInteraction_;
+	py::object vector_, quaternion_;  // refilled for each setter call
+	Vector3* vectorValue_;
+	Eigen::Quaterniond* quaternionValue_;
+	std::vector<BodyObjects> bodies_;                  // per block
+	bool resend_ = false;                              // write every body in full next (forgetBodies)
+	std::map<std::size_t, VertexList> vertexLists_;    // per vertex count
+	std::map<std::pair<int, int>, PairObjects> pairs_;  // the interactions this object keeps
+	std::vector<BodyForce> written_;                    // per block: what O.forces holds of it, as written
+	long forceReadBacks_ = 0;
+};
+
+}  // namespace dda
