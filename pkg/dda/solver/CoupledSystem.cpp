@@ -3,9 +3,6 @@
 #include "dda/core/CapacityBytes.hpp"
 
 #include <Eigen/Cholesky>
-#include <Eigen/OrderingMethods>
-#include <Eigen/SparseCholesky>
-#include <Eigen/SparseCore>
 
 #include <algorithm>
 #include <numeric>
@@ -14,65 +11,16 @@
 
 namespace dda {
 
-using SparseLLT = Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>>;
-
-namespace {
-
-// Eigen's SimplicialLLT, analysed once and then fed its permuted matrix
-// directly. compute(K) and factorize(K) both permute K into the upper
-// triangle of P K P^T (`ordering`, and factorize's own copy, by the same
-// expression) before factorize_preordered; the permuted matrix's layout
-// depends on K's pattern and P alone, so it is built once, with each entry's
-// assembly index as its value, and each solve writes the values where those
-// indices landed: factorize_preordered then sees the very matrix factorize(K)
-// would have built.
-class KeptCholesky : public SparseLLT {
-public:
-	// Analyses the pattern of `indexed` (lower triangle, values: assembly
-	// indices; only the pattern is used) and keeps its permuted copy.
-	void analyse(const Eigen::SparseMatrix<double>& indexed) {
-		const Eigen::SparseMatrix<double>* permuted = nullptr;
-		this->ordering(indexed, permuted, permuted_);
-		this->analyzePattern_preordered(*permuted, false);
-		if (permuted != &permuted_) permuted_ = *permuted;
-	}
-	Eigen::SparseMatrix<double>& permuted() { return permuted_; }
-	void factorizePermuted() { this->template factorize_preordered<false>(permuted_); }
-
-private:
-	Eigen::SparseMatrix<double> permuted_;  // upper triangle of P K P^T
-};
-
-}  // namespace
-
 struct CoupledSystem::Analysis {
 	std::vector<int> pattern;  // unknowns per slot, then each link's (lo, hi) within the component
 	std::size_t hash = 0;
-	int unknowns = 0;            // 0: not yet analysed
-	std::vector<int> position;   // per entry in assembly order, its index in the permuted matrix's values
-	KeptCholesky llt;
+	bool analysed = false;
+	BlockCholesky cholesky;
 	long lastBuild = 0;
 	std::size_t bytes = 0;
 };
 
 void CoupledSystem::AnalysisDeleter::operator()(Analysis* a) const { delete a; }
-
-namespace {
-// Analyses the pattern of the lower-triangle `entries` (values: their
-// assembly indices) of an n x n matrix, and sets position[e] to entry e's
-// index in the permuted matrix's values.
-void analysePattern(const std::vector<Eigen::Triplet<double>>& entries, int n, KeptCholesky& llt,
-                    std::vector<int>& position) {
-	Eigen::SparseMatrix<double> indexed(n, n);
-	indexed.setFromTriplets(entries.begin(), entries.end());
-	llt.analyse(indexed);
-	const Eigen::SparseMatrix<double>& permuted = llt.permuted();
-	position.assign(entries.size(), -1);
-	const double* index = permuted.valuePtr();
-	for (Eigen::Index p = 0; p < permuted.nonZeros(); ++p)
-		position[static_cast<std::size_t>(index[p])] = static_cast<int>(p);
-}
-}  // namespace
 
 namespace {
 
@@ -262,74 +210,27 @@ bool CoupledSystem::solveSingleBlock(int slot, std::vector<Vector12>& solutions)
 	return llt.info() == Eigen::Success;
 }
 
-template <class Entry>
-void CoupledSystem::forEachEntry(int c, const std::vector<int>& offset, Entry&& entry) const {
+std::vector<std::pair<int, int>> CoupledSystem::localLinks(int c) const {
+	const int first = componentStart_[c];
+	std::vector<std::pair<int, int>> links;
+	links.reserve(linkStart_[c + 1] - linkStart_[c]);
+	for (int l = linkStart_[c]; l < linkStart_[c + 1]; ++l)
+		links.emplace_back(linkSlots_[l].first - first, linkSlots_[l].second - first);
+	return links;
+}
+
+bool CoupledSystem::solveComponent(int c, BlockCholesky& cholesky, bool analyse,
+                                   std::vector<Vector12>& solutions) const {
 	const int first = componentStart_[c], last = componentStart_[c + 1];
+	if (analyse) cholesky.analyse(last - first, localLinks(c));
+	if (!cholesky.factorize(&diagonal_[first], &offDiagonal_[linkStart_[c]], &unknowns_[first])) return false;
+	std::vector<Vector12> x(force_.begin() + first, force_.begin() + last);
+	cholesky.solve(x.data());
 	for (int s = first; s < last; ++s) {
-		const int base = offset[s - first], size = unknowns_[s];
-		for (int col = 0; col < size; ++col)
-			for (int row = col; row < size; ++row) entry(base + row, base + col, diagonal_[s](row, col));
+		Vector12& solution = solutions[members_[s]];
+		solution = x[s - first];
+		if (unknowns_[s] != kBlockDofs) solution.tail<kBlockDofs - kRigidBlockDofs>().setZero();
 	}
-	for (int link = linkStart_[c]; link < linkStart_[c + 1]; ++link) {
-		const auto [lo, hi] = linkSlots_[link];
-		const int rowBase = offset[hi - first], colBase = offset[lo - first];
-		const int rows = unknowns_[hi], cols = unknowns_[lo];
-		const Matrix12& m = offDiagonal_[link];
-		for (int col = 0; col < cols; ++col)
-			for (int row = 0; row < rows; ++row) entry(rowBase + row, colBase + col, m(col, row));
-	}
-}
-
-std::size_t CoupledSystem::entryCount(int c) const {
-	return static_cast<std::size_t>(componentStart_[c + 1] - componentStart_[c]) * 78 +
-	       static_cast<std::size_t>(linkStart_[c + 1] - linkStart_[c]) * 144;
-}
-
-bool CoupledSystem::solveFresh(int c, const std::vector<int>& offset, const Eigen::VectorXd& rhs,
-                               Eigen::VectorXd& x) const {
-	const int n = offset.back();
-	std::vector<Eigen::Triplet<double>> entries;
-	entries.reserve(entryCount(c));
-	forEachEntry(c, offset, [&](int row, int col, double value) { entries.emplace_back(row, col, value); });
-	Eigen::SparseMatrix<double> K(n, n);
-	K.setFromTriplets(entries.begin(), entries.end());
-	SparseLLT llt(K);
-	if (llt.info() != Eigen::Success) return false;
-	x = llt.solve(rhs);
-	return true;
-}
-
-bool CoupledSystem::solveKept(int c, const std::vector<int>& offset, Analysis& analysis, const Eigen::VectorXd& rhs,
-                              Eigen::VectorXd& x, int& newAnalyses, int& reusedAnalyses) const {
-	const int n = offset.back();
-	if (analysis.unknowns != n) {
-		// New pattern: the matrix setFromTriplets builds, with each
-		// entry's assembly index as its value, permuted as factorize
-		// would, says where each entry goes.
-		std::vector<Eigen::Triplet<double>> entries;
-		entries.reserve(entryCount(c));
-		forEachEntry(c, offset, [&](int row, int col, double) {
-			entries.emplace_back(row, col, static_cast<double>(entries.size()));
-		});
-		analysePattern(entries, n, analysis.llt, analysis.position);
-		const Eigen::SparseMatrix<double>& permuted = analysis.llt.permuted();
-		analysis.unknowns = n;
-		analysis.bytes = static_cast<std::size_t>(permuted.nonZeros()) * (sizeof(double) + sizeof(int)) +
-		                 capacityBytes(analysis.position) +
-		                 static_cast<std::size_t>(analysis.llt.matrixL().nestedExpression().nonZeros()) *
-		                     (sizeof(double) + sizeof(int)) +
-		                 static_cast<std::size_t>(n) * 6 * sizeof(int);
-		++newAnalyses;
-	} else {
-		++reusedAnalyses;
-	}
-	double* values = analysis.llt.permuted().valuePtr();
-	const int* position = analysis.position.data();
-	std::size_t e = 0;
-	forEachEntry(c, offset, [&](int, int, double value) { values[position[e++]] = value; });
-	analysis.llt.factorizePermuted();
-	if (analysis.llt.info() != Eigen::Success) return false;
-	x = analysis.llt.solve(rhs);
 	return true;
 }
 
@@ -350,28 +251,26 @@ void CoupledSystem::solve(std::vector<Vector12>& solutions, int threadsFrom) {
 			}
 			continue;
 		}
-		// Variable block sizes: slot s's unknowns start at offset[s - first]
-		// and number unknowns_[s] (12, or 6 for a rigid block, whose strain
-		// rows and columns of the stored 12x12 blocks are left out).
-		std::vector<int> offset(last - first + 1, 0);
-		for (int s = first; s < last; ++s) offset[s - first + 1] = offset[s - first] + unknowns_[s];
-		const int n = offset.back();
-		solved += n;
-		Eigen::VectorXd rhs(n);
-		for (int s = first; s < last; ++s) rhs.segment(offset[s - first], unknowns_[s]) = force_[s].head(unknowns_[s]);
+		for (int s = first; s < last; ++s) solved += unknowns_[s];
 		Analysis* analysis = componentAnalysis_.empty() ? nullptr : componentAnalysis_[c];
-		Eigen::VectorXd x;
-		const bool solvedHere = analysis ? solveKept(c, offset, *analysis, rhs, x, newAnalyses, reusedAnalyses)
-		                                 : solveFresh(c, offset, rhs, x);
+		bool solvedHere;
+		if (analysis) {
+			const bool analyse = !analysis->analysed;
+			solvedHere = solveComponent(c, analysis->cholesky, analyse, solutions);
+			if (analyse) {
+				analysis->analysed = true;
+				analysis->bytes = analysis->cholesky.memoryBytes();
+				++newAnalyses;
+			} else {
+				++reusedAnalyses;
+			}
+		} else {
+			BlockCholesky cholesky;
+			solvedHere = solveComponent(c, cholesky, true, solutions);
+		}
 		if (!solvedHere) {
 #pragma omp atomic write
 			failed = true;
-			continue;
-		}
-		for (int s = first; s < last; ++s) {
-			const int k = members_[s], size = unknowns_[s];
-			solutions[k].setZero();
-			solutions[k].head(size) = x.segment(offset[s - first], size);
 		}
 	}
 	if (failed) throw std::runtime_error("the DDA system is not positive definite (Cholesky failed)");

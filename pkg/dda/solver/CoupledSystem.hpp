@@ -6,7 +6,7 @@
 // closed contact joins form independent components, each solved on its own:
 //   - one block with closed contacts (against fixed blocks) or fixed points: a dense
 //     12x12 Cholesky;
-//   - several blocks: a sparse Cholesky (Eigen's SimplicialLLT, AMD order).
+//   - several blocks: a sparse Cholesky on 12x12 blocks (BlockCholesky.hpp).
 // A block without springs is not part of it: World solves it by the block's
 // own 3 + 9 solve (BlockEquations.hpp), so a free block is not affected by the
 // rest of the scene, not even by round-off, and costs no stored 12x12 block.
@@ -18,31 +18,28 @@
 // links (sorted by slot pair) are contiguous ranges.
 //
 // Analysis reuse. A sparse component's matrix pattern (its block sizes and
-// links, numbered within the component), the map from its 12x12 blocks to
-// the compressed matrix's values and Eigen's symbolic analysis (the AMD
-// ordering and elimination tree) depend on that pattern alone: they are kept
-// per pattern and reused by every solve with the same pattern (the open-close
-// iteration's solves between structure changes, the structures it swaps
-// between, the next steps of a resting pile). The values go straight into
-// the permuted matrix the factorisation reads (P K P^T's upper triangle),
-// each where Eigen's permutation of setFromTriplets' matrix puts it (a
-// component has no duplicate entries, so it is the same matrix, entry for
-// entry, in the same order), and the numeric factorisation runs exactly the
-// arithmetic of compute(): the solutions are bitwise those of a fresh analysis
-// (tests/cpp/solver/test_rigid_blocks.cpp compares them). Patterns unused for
+// links, numbered within the component) decides its factorisation's
+// symbolic analysis (BlockCholesky::analyse: the block order, the factor's
+// pattern, the update targets): it is kept per pattern and reused by every
+// solve with the same pattern (the open-close iteration's solves between
+// structure changes, the structures it swaps between, the next steps of a
+// resting pile). The numeric factorisation depends on the pattern and the
+// values alone, so the solutions are bitwise those of a fresh analysis
+// (tests/cpp/solver/test_effects.cpp compares them). Patterns unused for
 // kKeptBuilds builds, or beyond the used patterns' size, are dropped.
 //
 // Rigid blocks have 6 unknowns, not 12. Every block keeps the 12-layout in
 // storage (contact terms are assembled as for any block), but a rigid block's
-// strain rows and columns never enter a factorisation: alone in its
-// component it is solved 6x6 (3 + 3 without springs, by World), and in a
-// sparse component the unknowns are numbered with variable block sizes
-// (offsets), the strain rows and columns of its stored blocks skipped.
-// Leaving them out is exactly the constraint strain = 0 (the restriction of
-// the quadratic energy to the rigid subspace); its solution's strain part is
-// set to zero.
+// strain unknowns are constrained to zero: alone in its component it is
+// solved 6x6 (3 + 3 without springs, by World), and in a sparse component
+// BlockCholesky replaces its strain rows and columns by the identity's, with
+// a zero right-hand side. That is exactly the restriction of the quadratic
+// energy to the rigid subspace (tests/cpp/solver/test_rigid_blocks.cpp
+// compares with the dense system with those rows struck out); its
+// solution's strain part is set to zero.
 #pragma once
 
+#include "BlockCholesky.hpp"
 #include "BlockEquations.hpp"
 
 #include <cstddef>
@@ -107,20 +104,12 @@ private:
 	// Solves the component of the single block in `slot` (a dense Cholesky of
 	// its 12 or 6 unknowns); false when the factorisation fails.
 	bool solveSingleBlock(int slot, std::vector<Vector12>& solutions) const;
-	// Calls entry(row, col, value) for the lower triangle of component c's
-	// matrix in assembly order: each diagonal block's, then each link's
-	// (the stored K[lo][hi] transposed); slot s's unknowns start at
-	// offset[s - first slot].
-	template <class Entry>
-	void forEachEntry(int c, const std::vector<int>& offset, Entry&& entry) const;
-	// Entries of component c's lower triangle [-].
-	std::size_t entryCount(int c) const;
-	// Solves component c's sparse system K x = rhs (n unknowns, slots at
-	// `offset`): a new factorisation, or its kept analysis refilled (counted
-	// in newAnalyses or reusedAnalyses). False when the factorisation fails.
-	bool solveFresh(int c, const std::vector<int>& offset, const Eigen::VectorXd& rhs, Eigen::VectorXd& x) const;
-	bool solveKept(int c, const std::vector<int>& offset, Analysis& analysis, const Eigen::VectorXd& rhs,
-	               Eigen::VectorXd& x, int& newAnalyses, int& reusedAnalyses) const;
+	// Component c's links within it: (lo, hi) slots less its first slot.
+	std::vector<std::pair<int, int>> localLinks(int c) const;
+	// Factorises component c's system (analysing its pattern first when
+	// `analyse`) and writes its blocks' solutions; false when the
+	// factorisation fails.
+	bool solveComponent(int c, BlockCholesky& cholesky, bool analyse, std::vector<Vector12>& solutions) const;
 
 	std::vector<int> slot_;            // per moving block: its slot, -1 when it has no springs
 	std::vector<int> members_;         // per slot: the moving block
