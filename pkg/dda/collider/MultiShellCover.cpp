@@ -16,6 +16,10 @@ namespace {
 
 // Blocks ahead whose corners are prefetched while boxes are updated.
 constexpr int kPrefetchBlocks = 4;
+// Scenes with fewer blocks update their shells on one thread: below about a
+// thousand blocks the update (0.1 us a block) is shorter than a thread
+// team's start. The solver's loops use the same threshold (StepClock.hpp).
+constexpr int kMinBlocksForThreads = 1024;
 
 void checkCover(double criticalLength, int segments, const std::string& what) {
 	if (!(criticalLength > 0) || !std::isfinite(criticalLength))
@@ -313,11 +317,15 @@ void MultiShellCover::forgetLinkedSets() {
 
 long MultiShellCover::updateShells(const std::vector<Block>& blocks) {
 	// The corners of the block kPrefetchBlocks ahead are fetched meanwhile
-	// (each block's are a separate allocation, usually out of cache).
+	// (each block's are a separate allocation, usually out of cache). Each
+	// block writes only its own cover, frame and shells: the blocks are
+	// shared among the step's threads (static chunks keep each thread's
+	// blocks consecutive, so the prefetch still runs ahead of it).
 	const int n = static_cast<int>(blocks.size());
-	const long updatesBefore = totalShellUpdates_;
 	const auto needsUpdate = [&](int b) { return !blocks[b].fixed || !covers_[b].boxesBuilt; };
 	resizeWithHeadroom(shellFixed_, shellBlock_.size());
+	long updates = 0;
+#pragma omp parallel for schedule(static, 256) reduction(+ : updates) if (n >= kMinBlocksForThreads)
 	for (int b = 0; b < n; ++b) {
 		std::fill_n(shellFixed_.begin() + covers_[b].firstShell, covers_[b].shellCount, blocks[b].fixed);
 		if (b + kPrefetchBlocks < n && needsUpdate(b + kPrefetchBlocks)) {
@@ -325,9 +333,10 @@ long MultiShellCover::updateShells(const std::vector<Block>& blocks) {
 			const char* first = reinterpret_cast<const char*>(ahead.data());
 			for (std::size_t byte = 0; byte < ahead.size() * sizeof(Vector3); byte += 64) __builtin_prefetch(first + byte);
 		}
-		if (needsUpdate(b)) updateBoxes(blocks[b], covers_[b], frames_[b]);
+		if (needsUpdate(b)) updates += updateBoxes(blocks[b], covers_[b], frames_[b]);
 	}
-	return totalShellUpdates_ - updatesBefore;
+	totalShellUpdates_ += updates;
+	return updates;
 }
 
 void MultiShellCover::updateFrame(const Block& block, const BlockCover& cover, Frame& frame) const {
@@ -352,7 +361,7 @@ void MultiShellCover::updateFrame(const Block& block, const BlockCover& cover, F
 	frame.firstShell = cover.firstShell;
 }
 
-void MultiShellCover::updateBoxes(const Block& block, BlockCover& cover, Frame& frame) {
+int MultiShellCover::updateBoxes(const Block& block, BlockCover& cover, Frame& frame) {
 	const std::vector<Vector3>& x = block.vertices;
 	updateFrame(block, cover, frame);
 	// Each point is computed once and added to the shells it lies in: a
@@ -385,7 +394,7 @@ void MultiShellCover::updateBoxes(const Block& block, BlockCover& cover, Frame& 
 		frame.reach = std::max({frame.reach, bounds[j].low.cwiseAbs().maxCoeff(), bounds[j].high.cwiseAbs().maxCoeff()});
 	}
 	cover.boxesBuilt = block.fixed;
-	totalShellUpdates_ += cover.shellCount;
+	return cover.shellCount;
 }
 
 std::size_t MultiShellCover::memoryBytes() const {

@@ -185,7 +185,7 @@ private:
 	static void copyFrameCorners(const PolyhedronTopology& shape, BlockCover& cover);
 	// The block's frame for this step, from its cover's frame faces.
 	void updateFrame(const Block& block, const BlockCover& cover, Frame& frame) const;
-	void updateBoxes(const Block& block, BlockCover& cover, Frame& frame);
+	int updateBoxes(const Block& block, BlockCover& cover, Frame& frame);  // returns the shells updated
 	// Reading (MultiShellCoverState.cpp): one block's cover, and the check
 	// and conversion of its per-shell lists to the compact form.
 	void readCover(StateReader& in, const Block& block, int b, BlockCover& c, bool& boxesBuilt);

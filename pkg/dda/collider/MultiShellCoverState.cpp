@@ -95,10 +95,8 @@ void MultiShellCover::read(StateReader& in, const std::vector<Block>& blocks) {
 	in.pod(totalShellUpdates_);
 	in.pod(coverBuilds_);
 	layoutShells();
-	const long updates = totalShellUpdates_;
 	for (std::size_t b = 0; b < covers_.size(); ++b)
-		if (boxesBuilt[b]) updateBoxes(blocks[b], covers_[b], frames_[b]);
-	totalShellUpdates_ = updates;
+		if (boxesBuilt[b]) updateBoxes(blocks[b], covers_[b], frames_[b]);   // not counted: the saved count holds
 }
 
 void MultiShellCover::readCover(StateReader& in, const Block& block, int b, BlockCover& c, bool& boxesBuilt) {

@@ -148,6 +148,7 @@ void ContactDetection::startChunks(const std::vector<Block>& blocks) {
 	if (static_cast<int>(pairResults_.size()) < chunkCapacity) pairResults_.resize(chunkCapacity);
 	pairFound_.resize(chunkCapacity);
 	pairWork_.resize(chunkCapacity);
+	pairArea_.resize(chunkCapacity);
 }
 
 void ContactDetection::claimPlanes(int begin, int next) {
@@ -210,42 +211,65 @@ void ContactDetection::detectChunk(Step& step, int begin, int count, int chunk) 
 			    BlockGeometry{B.shape.get(), &B.vertices, B.centroid, internalB, &planes_[planeSlot_[b]]},
 			    detection, pairResults_[q], step.store.previousEntrance(a, b), step.collider.linked(begin + q),
 			    &pairWork_[q]);
+			if (pairFound_[q]) pairArea_[q] = contactArea(pairResults_[q]);
 		}
 	}
 	releasePlanes(begin, next, chunk);
 	// The chunk's results into the store in pair order, as they would be
 	// without chunks: the pair loop reads only the previous step's
 	// entrances from the store, which these calls leave alone.
+	const int firstContact = static_cast<int>(step.store.contacts().size());
 	for (int q = 0; q < count; ++q) {
 		stats.subUnitTests += pairWork_[q].subUnitTests;
 		stats.fullSearchPairs += pairWork_[q].fullSearches;
 		if (!pairFound_[q]) continue;
 		const auto [a, b] = pairs_[begin + q];
-		storePair(step, a, b, pairResults_[q]);
+		storePair(step, a, b, pairResults_[q], pairArea_[q]);
 	}
+	prepareContacts(step, firstContact);
 }
 
-void ContactDetection::storePair(Step& step, int a, int b, const PairContacts& pair) {
+// The pair's contact area [m^2] shared by its sub-contacts (bond strengths):
+// the area of the hull of their points on block j, projected along the
+// pair's normal, over their number.
+double ContactDetection::contactArea(const PairContacts& pair) {
+	if (pair.contacts.empty()) return 0.0;
+	thread_local std::vector<Vector3> points;
+	points.clear();
+	for (const SubContact& sub : pair.contacts) points.push_back(sub.pointJ);
+	return projectedHullArea(points, pair.normal) / pair.contacts.size();
+}
+
+// The contacts the chunk added (from `first` on) get their springs, limits
+// and linearised gaps, each from its own blocks alone: in parallel, with the
+// same arithmetic per contact as in any order.
+void ContactDetection::prepareContacts(Step& step, int first) {
+	std::vector<Contact>& contacts = step.store.contacts();
+	const int last = static_cast<int>(contacts.size());
+	long friction = 0;
+#pragma omp parallel for schedule(dynamic, 64) reduction(+ : friction) if (step.threads && last - first >= 256)
+	for (int k = first; k < last; ++k) {
+		Contact& contact = contacts[k];
+		prepareContact(contact, step.blocks[contact.key.blockI], step.blocks[contact.key.blockJ], step.settings);
+		contact.frictionTangent *= step.frictionScale;
+		friction += contact.frictionTangent > 0;
+	}
+	step.stats.frictionContacts += friction;
+}
+
+void ContactDetection::storePair(Step& step, int a, int b, const PairContacts& pair, double area) {
 	++step.stats.contactPairs;
 	step.store.setEntrance(a, b, pair.entrance);
-	// The pair's contact area, shared by its sub-contacts (bond strengths).
-	points_.clear();
-	for (const SubContact& sub : pair.contacts) points_.push_back(sub.pointJ);
-	const double area = pair.contacts.empty() ? 0.0 : projectedHullArea(points_, pair.normal) / pair.contacts.size();
 	for (const SubContact& sub : pair.contacts) {
 		const int i = sub.firstIsA ? a : b, j = sub.firstIsA ? b : a;
 		const ContactKey key{i, j, sub.kind, sub.feature1, sub.feature2};
-		Contact& contact = step.store.add(key, pair.type, sub, *step.blocks[i].shape, *step.blocks[j].shape);
-		contact.area = area;
-		prepareContact(contact, step.blocks[i], step.blocks[j], step.settings);
-		contact.frictionTangent *= step.frictionScale;
-		step.stats.frictionContacts += contact.frictionTangent > 0;
+		step.store.add(key, pair.type, sub, *step.blocks[i].shape, *step.blocks[j].shape).area = area;
 	}
 }
 
 std::size_t ContactDetection::memoryBytes() const {
 	std::size_t bytes = capacityBytes(pairs_) + capacityBytes(pairResults_) + capacityBytes(pairFound_) +
-	                    capacityBytes(pairWork_) + capacityBytes(points_) + capacityBytes(planes_) +
+	                    capacityBytes(pairWork_) + capacityBytes(pairArea_) + capacityBytes(planes_) +
 	                    capacityBytes(planeSlot_) + capacityBytes(lastChunk_) + capacityBytes(freePlanes_) +
 	                    capacityBytes(planeBlocks_) + capacityBytes(diagonals_);
 	// Every pooled result and planes entry, found or not: each keeps its capacity.

@@ -77,7 +77,12 @@ private:
 	// The entries of the blocks of pairs [begin, next) whose last chunk is `chunk`.
 	void releasePlanes(int begin, int next, int chunk);
 	// Adds the sub-contacts of pair (a, b) to the store.
-	void storePair(Step& step, int a, int b, const PairContacts& pair);
+	// A found pair's sub-contacts into the store (in pair order: each takes
+	// over its predecessor's history), with the pair's contact area [m^2].
+	void storePair(Step& step, int a, int b, const PairContacts& pair, double area);
+	static double contactArea(const PairContacts& pair);
+	// The springs and linearised gaps of the store's contacts from `first` on.
+	void prepareContacts(Step& step, int first);
 
 	std::vector<std::pair<int, int>> pairs_;
 	// The narrow phase runs the candidate pairs in chunks (kPairChunk in
@@ -104,7 +109,7 @@ private:
 	// Faces of fixed blocks covered by a flush neighbour (BlockGeometry::internalFaces).
 	std::vector<std::vector<char>> internalFaces_;
 	int internalFacesBlocks_ = -1;  // block count when internalFaces_ was computed
-	std::vector<Vector3> points_;   // storePair's work array
+	std::vector<double> pairArea_;  // per pair of the chunk, its contact area [m^2] (found pairs)
 };
 
 }  // namespace dda
