@@ -33,6 +33,11 @@ namespace {
 // Shell pairs ahead whose second shell's box is prefetched in the cache's
 // final test, and whose second block's frame is prefetched in the frame test.
 constexpr std::size_t kPrefetchHits = 16;
+// The frame tests of block pairs, per group of shell pairs: prefetch
+// distance, and the fewest groups worth a thread team (a group's test takes
+// about 0.2 us).
+constexpr int kPrefetchGroups = 8;
+constexpr int kMinGroupsForThreads = 1024;
 
 }  // namespace
 
@@ -165,49 +170,61 @@ void MSCCollider::findShellHits(const std::vector<Block>& blocks, double margin,
 	stats.shellTests += static_cast<long>(cached.size());
 }
 
+// The frame test of each block pair's shell pairs (a run of hits_ with the
+// same two blocks: a group) is pure and runs on the step's threads; the
+// candidates and their linked sets (interned in order: set numbers follow
+// the pairs) are then taken in group order, as by one thread.
 void MSCCollider::testBlockPairs(double margin, std::vector<std::pair<int, int>>& pairs, BroadPhaseStatistics& stats) {
 	const std::vector<int>& shellBlock = cover_.shellBlock();
 	const std::vector<msc::Frame>& frames = cover_.frames();
 	candidateSets_.clear();
-	// The second blocks' frames and shells' extents are far apart in memory:
-	// those of the shell pair kPrefetchHits ahead are fetched meanwhile, and
-	// the first linked set of the second block half as far ahead (its frame
-	// fetched by then).
-	std::size_t prefetched = 0, prefetchedSets = 0;
-	const auto prefetchUpTo = [&](std::size_t ahead) {
-		for (std::size_t last = std::min(ahead, hits_.size()); prefetched < last; ++prefetched) {
-			const int t = hits_[prefetched].second;
+	groupStart_.clear();
+	for (std::size_t h = 0; h < hits_.size(); ++h) {
+		if (h == 0 || shellBlock[hits_[h].first] != shellBlock[hits_[h - 1].first] ||
+		    shellBlock[hits_[h].second] != shellBlock[hits_[h - 1].second])
+			groupStart_.push_back(h);
+	}
+	const int groups = static_cast<int>(groupStart_.size());
+	groupStart_.push_back(hits_.size());
+	groupShells_.resize(groups);
+	stats.shellTests += static_cast<long>(hits_.size());
+	long shellPairs = 0;
+#pragma omp parallel for schedule(dynamic, 256) reduction(+ : shellPairs) if (groups >= kMinGroupsForThreads)
+	for (int g = 0; g < groups; ++g) {
+		// The second block's frame and extents are far apart in memory: those
+		// of the group kPrefetchGroups ahead are fetched meanwhile.
+		if (g + kPrefetchGroups < groups) {
+			const int t = hits_[groupStart_[g + kPrefetchGroups]].second;
 			const char* frame = reinterpret_cast<const char*>(&frames[shellBlock[t]]);
 			for (std::size_t byte = 0; byte < sizeof(msc::Frame); byte += 64) __builtin_prefetch(frame + byte);
 			__builtin_prefetch(&cover_.extentLow()[t]);
 			__builtin_prefetch(&cover_.extentHigh()[t]);
 		}
-		for (std::size_t last = std::min(ahead - kPrefetchHits / 2, hits_.size()); prefetchedSets < last; ++prefetchedSets) {
-			const int set = frames[shellBlock[hits_[prefetchedSets].second]].linkedSets;
-			if (set >= 0) linkedSets_.prefetch(set);
-		}
-	};
-	for (std::size_t h = 0; h < hits_.size();) {
-		prefetchUpTo(h + kPrefetchHits);
-		const int a = shellBlock[hits_[h].first], b = shellBlock[hits_[h].second];
-		std::size_t end = h + 1;
-		while (end < hits_.size() && shellBlock[hits_[end].first] == a && shellBlock[hits_[end].second] == b) ++end;
-		const msc::Frame& fa = frames[a];
-		const msc::Frame& fb = frames[b];
+		const std::size_t first = groupStart_[g], end = groupStart_[g + 1];
+		const msc::Frame& fa = frames[shellBlock[hits_[first].first]];
+		const msc::Frame& fb = frames[shellBlock[hits_[first].second]];
 		msc::FrameTest frameTest(fa, fb, margin, cover_.extentLow(), cover_.extentHigh());
 		std::uint64_t shellsA = 0, shellsB = 0;
-		stats.shellTests += static_cast<long>(end - h);
-		for (; h < end; ++h) {
+		for (std::size_t h = first; h < end; ++h) {
 			const int s = hits_[h].first, t = hits_[h].second;
 			if (!frameTest.near(s, t)) continue;
-			++stats.shellPairs;
+			++shellPairs;
 			shellsA |= std::uint64_t{1} << (s - fa.firstShell);
 			shellsB |= std::uint64_t{1} << (t - fb.firstShell);
 		}
-		if (shellsA) {
-			pairs.emplace_back(a, b);
-			pushWithHeadroom(candidateSets_, {linkedSet(a, shellsA), linkedSet(b, shellsB)});
+		groupShells_[g] = {shellsA, shellsB};
+	}
+	stats.shellPairs += shellPairs;
+	for (int g = 0; g < groups; ++g) {
+		if (g + kPrefetchGroups < groups) {   // the second block's first linked set (its frame is in cache)
+			const int set = frames[shellBlock[hits_[groupStart_[g + kPrefetchGroups]].second]].linkedSets;
+			if (set >= 0) linkedSets_.prefetch(set);
 		}
+		const auto [shellsA, shellsB] = groupShells_[g];
+		if (!shellsA) continue;
+		const int a = shellBlock[hits_[groupStart_[g]].first], b = shellBlock[hits_[groupStart_[g]].second];
+		pairs.emplace_back(a, b);
+		pushWithHeadroom(candidateSets_, {linkedSet(a, shellsA), linkedSet(b, shellsB)});
 	}
 }
 
@@ -226,7 +243,8 @@ void MSCCollider::fillLinked(std::size_t candidates, BroadPhaseStatistics& stats
 
 std::size_t MSCCollider::memoryBytes() const {
 	return cover_.memoryBytes() + grid_.memoryBytes() + linkedSets_.memoryBytes() + cache_.memoryBytes() +
-	       capacityBytes(widened_) + capacityBytes(pairStart_) + capacityBytes(hits_) + capacityBytes(candidateSets_) +
+	       capacityBytes(widened_) + capacityBytes(pairStart_) + capacityBytes(hits_) + capacityBytes(candidateSets_) + capacityBytes(groupStart_) +
+	       capacityBytes(groupShells_) +
 	       capacityBytes(linked_);
 }
 

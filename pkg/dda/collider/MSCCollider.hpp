@@ -147,6 +147,8 @@ private:
 	std::vector<ItemPair> hits_;                // the shell pairs whose d0-boxes meet, sorted
 	// Per candidate its two linked sets, until linked_ is filled.
 	std::vector<std::array<int, 2>> candidateSets_;
+	std::vector<std::size_t> groupStart_;                               // testBlockPairs: runs of hits_ per block pair
+	std::vector<std::pair<std::uint64_t, std::uint64_t>> groupShells_;  // and their near shells (bit masks)
 	std::vector<LinkedSubUnits> linked_;  // the first linkedCount_ are valid
 	int linkedCount_ = 0;
 };

@@ -16,6 +16,9 @@ using Clock = std::chrono::steady_clock;
 // threads on a loaded 2-core machine, 0.5 ms with one. A block's own work is
 // about a microsecond, so below ~1000 blocks threads cannot pay.
 constexpr int kMinBlocksForThreads = 1024;
+// The same for per-contact loops: a contact's own work is a few tenths of a
+// microsecond.
+constexpr int kMinContactsForThreads = 2048;
 
 inline double secondsSince(Clock::time_point start) {
 	return std::chrono::duration<double>(Clock::now() - start).count();

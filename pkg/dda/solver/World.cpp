@@ -220,27 +220,51 @@ void World::moveContactsAndBlocks(const IntegratorSettings& settings, double dt,
 	// Contacts first (forces from the accepted solution, anchors carried along
 	// with their blocks), then the blocks themselves.
 	motions_.resize(n);
+#pragma omp parallel for schedule(static) if (n >= kMinBlocksForThreads)
 	for (int k = 0; k < n; ++k) motions_[k] = blockMotion(blocks_[moving[k]], openClose_.solution(k));
-	for (Contact& contact : store_.contacts()) {
-		const int bi = contact.key.blockI, bj = contact.key.blockJ;
-		const int mi = openClose_.movingIndex(bi), mj = openClose_.movingIndex(bj);
-		const Vector12& Di = openClose_.solutionOf(bi);
-		const Vector12& Dj = openClose_.solutionOf(bj);
-		finishContact(contact, blocks_[bi], blocks_[bj], Di, Dj);
-		ContactHistory& trial = contact.trial;
-		contact.point = mi >= 0 ? motions_[mi](contact.geometry.pointI) : contact.geometry.pointI;
-		if (trial.state != ContactState::Open) {
-			if (mi >= 0) trial.anchorI = motions_[mi](trial.anchorI);
-			if (mj >= 0) trial.anchorJ = motions_[mj](trial.anchorJ);
+	// Each contact writes only itself; the counts are integer sums and the
+	// deepest penetration a max from the same start (+0 or the step's value:
+	// a -0 never replaces it), so any split over threads gives the same.
+	std::vector<Contact>& contacts = store_.contacts();
+	const int contactCount = static_cast<int>(contacts.size());
+	long closedCount = 0, slidingCount = 0, bondedCount = 0;
+	double deepest = stats.maxPenetration;
+#pragma omp parallel if (contactCount >= kMinContactsForThreads)
+	{
+		long closedHere = 0, slidingHere = 0, bondedHere = 0;
+		double deepestHere = stats.maxPenetration;
+#pragma omp for schedule(static)
+		for (int c = 0; c < contactCount; ++c) {
+			Contact& contact = contacts[c];
+			const int bi = contact.key.blockI, bj = contact.key.blockJ;
+			const int mi = openClose_.movingIndex(bi), mj = openClose_.movingIndex(bj);
+			const Vector12& Di = openClose_.solutionOf(bi);
+			const Vector12& Dj = openClose_.solutionOf(bj);
+			finishContact(contact, blocks_[bi], blocks_[bj], Di, Dj);
+			ContactHistory& trial = contact.trial;
+			contact.point = mi >= 0 ? motions_[mi](contact.geometry.pointI) : contact.geometry.pointI;
+			if (trial.state != ContactState::Open) {
+				if (mi >= 0) trial.anchorI = motions_[mi](trial.anchorI);
+				if (mj >= 0) trial.anchorJ = motions_[mj](trial.anchorJ);
+				++closedHere;
+				slidingHere += trial.state == ContactState::Sliding;
+				deepestHere = std::max(deepestHere, -contactGap(contact, Di, Dj));
+			}
+			contact.history = trial;
+			bondedHere += trial.bonded;
 		}
-		if (trial.state != ContactState::Open) {
-			++stats.closedContacts;
-			stats.slidingContacts += trial.state == ContactState::Sliding;
-			stats.maxPenetration = std::max(stats.maxPenetration, -contactGap(contact, Di, Dj));
+#pragma omp critical(ddaFinishContacts)
+		{
+			closedCount += closedHere;
+			slidingCount += slidingHere;
+			bondedCount += bondedHere;
+			deepest = std::max(deepest, deepestHere);
 		}
-		contact.history = trial;
-		stats.bondedContacts += trial.bonded;
 	}
+	stats.closedContacts += static_cast<int>(closedCount);
+	stats.slidingContacts += static_cast<int>(slidingCount);
+	stats.bondedContacts += static_cast<int>(bondedCount);
+	stats.maxPenetration = deepest;
 #pragma omp parallel for schedule(static) if (n >= kMinBlocksForThreads)
 	for (int k = 0; k < n; ++k) {
 		Block& block = blocks_[moving[k]];
