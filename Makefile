@@ -8,7 +8,7 @@ DEB_PACKAGES := yade cmake g++ make libeigen3-dev libcgal-dev libgmp-dev libmpfr
                 python3-distributed libgtest-dev
 SITE_DIR := $(shell $(PYTHON) -c "import sysconfig;print(sysconfig.get_path('purelib','posix_local'))" 2>/dev/null)
 
-.PHONY: deps build install demo test test-hard test-cpp test-py bench bench-pile200 fingerprints docs regress regress-quick regress-run sweep fuzz mutations clean
+.PHONY: deps build install demo test test-hard test-cpp test-py bench bench-scale bench-pile200 fingerprints docs regress regress-quick regress-run sweep fuzz mutations clean
 
 deps:
 	@missing=$$(for p in $(DEB_PACKAGES); do dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null | grep -q 'install ok installed' || echo $$p; done); \
@@ -52,6 +52,12 @@ bench: install
 	$(PYTHON) bench/effects.py
 	$(PYTHON) bench/energy.py
 	$(PYTHON) bench/bounce.py
+
+# Issue 21's speed table (bench/out/scale.json, scale_steps.png): detection against YADE's collider,
+# the full step on 1 and 2 threads and the sync's share at 1,000 to 50,000 blocks, the paper's drop
+# in steps per second. About half an hour (YADE's 50,000-block steps take seconds); needs a quiet machine.
+bench-scale: install
+	$(PYTHON) bench/scale.py
 
 # The issue-17 200-cube pile at 1e5..1e11 Pa (bench/out/energy_pile200.json): about half an hour
 # on one core, so not in `bench`.
