@@ -14,12 +14,6 @@ using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using ExactPoint = Kernel::Point_3;
 using ExactVector = Kernel::Vector_3;
 
-// |C . (B x A)| computed in double for unit vectors A, B, C (normalized face
-// normals, components within 1 + 4 DBL_EPSILON of 1 in magnitude) is within
-// about 21 DBL_EPSILON (~5e-15) of the exact triple product of those doubles;
-// above this bound its sign is the exact sign (dimensionless).
-constexpr double kUnitTripleRoundoff = 1e-13;
-
 // A component a_j b_k - a_k b_j of a cross product computed in double is
 // within 4 DBL_EPSILON max|a_i| max|b_i| of its exact value (barring
 // underflow); above this factor the exact cross product is not zero.
@@ -49,9 +43,7 @@ bool parallelDirections(const Vector3& da, const Vector3& db, double sinToleranc
 	return parallelDirections(da, db, cross, cross.norm(), da.norm(), db.norm(), sinTolerance);
 }
 
-int unitOrientation(double approx, const Vector3& x, const Vector3& y, const Vector3& z) {
-	if (approx > kUnitTripleRoundoff) return 1;
-	if (approx < -kUnitTripleRoundoff) return -1;
+int unitOrientationExact(const Vector3& x, const Vector3& y, const Vector3& z) {
 	// Exactly zero when each of the determinant's six terms x_i y_j z_k has a
 	// zero factor (axis-aligned normals).
 	bool zero = true;

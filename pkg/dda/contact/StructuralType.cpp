@@ -31,7 +31,12 @@ Feature featureOf(const Prepared& block, const std::vector<Vector3>& points, dou
 	for (int v = 0; v < block.cornerCount(); ++v) {
 		const Vector3& c = block.corner(v);
 		bool far = false;
-		for (const Vector3& x : points) far = far || (x - c).cwiseAbs().maxCoeff() > reach;
+		for (const Vector3& x : points) {
+			if ((x - c).cwiseAbs().maxCoeff() > reach) {
+				far = true;
+				break;
+			}
+		}
 		if (far) continue;
 		double worst = 0;
 		for (const Vector3& x : points) worst = std::max(worst, (x - c).norm());
@@ -53,7 +58,12 @@ Feature featureOf(const Prepared& block, const std::vector<Vector3>& points, dou
 		const Vector3& q = block.edgeEnd(e);
 		const Vector3 lower = p.cwiseMin(q).array() - margin, upper = p.cwiseMax(q).array() + margin;
 		bool far = false;
-		for (const Vector3& x : points) far = far || (x.array() > upper.array()).any() || (x.array() < lower.array()).any();
+		for (const Vector3& x : points) {
+			if ((x.array() > upper.array()).any() || (x.array() < lower.array()).any()) {
+				far = true;
+				break;
+			}
+		}
 		if (far) continue;
 		double worst = 0;
 		for (const Vector3& x : points) worst = std::max(worst, segmentDistance(x, p, q));
