@@ -14,11 +14,6 @@ using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using ExactPoint = Kernel::Point_3;
 using ExactVector = Kernel::Vector_3;
 
-// A component a_j b_k - a_k b_j of a cross product computed in double is
-// within 4 DBL_EPSILON max|a_i| max|b_i| of its exact value (barring
-// underflow); above this factor the exact cross product is not zero.
-constexpr double kCrossRoundoffRelative = 1e-14;
-
 ExactPoint exactPoint(const Vector3& p) { return ExactPoint(p.x(), p.y(), p.z()); }
 ExactVector exactVector(const Vector3& v) { return ExactVector(v.x(), v.y(), v.z()); }
 
@@ -28,13 +23,7 @@ int exactOrientation(const Vector3& a, const Vector3& b, const Vector3& c, const
 	return static_cast<int>(CGAL::orientation(exactPoint(a), exactPoint(b), exactPoint(c), exactPoint(d)));
 }
 
-bool parallelDirections(const Vector3& da, const Vector3& db, const Vector3& cross, double crossNorm, double la,
-                        double lb, double sinTolerance) {
-	if (crossNorm <= sinTolerance * la * lb) return true;
-	// Not within the angle: parallel only when exactly collinear. A component
-	// of the double cross product above its round-off bound proves it is not.
-	const double scale = da.cwiseAbs().maxCoeff() * db.cwiseAbs().maxCoeff();
-	if (scale > 1e-250 && scale < 1e250 && cross.cwiseAbs().maxCoeff() > kCrossRoundoffRelative * scale) return false;
+bool exactlyCollinear(const Vector3& da, const Vector3& db) {
 	return CGAL::collinear(ExactPoint(0, 0, 0), exactPoint(da), exactPoint(db));
 }
 

@@ -29,8 +29,24 @@ int exactOrientation(const Vector3& a, const Vector3& b, const Vector3& c, const
 // sinTolerance = sin(angleTolerance); la = |da|, lb = |db|.
 // `cross` = da x db and `crossNorm` = |cross| as computed by the callers
 // (Eigen's cross() and norm()).
-bool parallelDirections(const Vector3& da, const Vector3& db, const Vector3& cross, double crossNorm, double la,
-                        double lb, double sinTolerance);
+// A component a_j b_k - a_k b_j of a cross product computed in double is
+// within 4 DBL_EPSILON max|a_i| max|b_i| of its exact value (barring
+// underflow); above this factor the exact cross product is not zero.
+inline constexpr double kCrossRoundoffRelative = 1e-14;
+
+// Whether da and db are exactly collinear (CGAL), for the cases the filter
+// of parallelDirections cannot settle.
+bool exactlyCollinear(const Vector3& da, const Vector3& db);
+
+inline bool parallelDirections(const Vector3& da, const Vector3& db, const Vector3& cross, double crossNorm, double la,
+                               double lb, double sinTolerance) {
+	if (crossNorm <= sinTolerance * la * lb) return true;
+	// Not within the angle: parallel only when exactly collinear. A component
+	// of the double cross product above its round-off bound proves it is not.
+	const double scale = da.cwiseAbs().maxCoeff() * db.cwiseAbs().maxCoeff();
+	if (scale > 1e-250 && scale < 1e250 && cross.cwiseAbs().maxCoeff() > kCrossRoundoffRelative * scale) return false;
+	return exactlyCollinear(da, db);
+}
 bool parallelDirections(const Vector3& da, const Vector3& db, double sinTolerance);
 
 // |x . (y x z)| computed in double for unit vectors x, y, z (normalized face
