@@ -32,12 +32,14 @@ std::pair<double, double> sinCosDegrees(double degrees) {
 	const double quadrant = std::nearbyint(reduced / 90.0);
 	const double r = (reduced - 90.0 * quadrant) * (kPi / 180.0);  // reduced - 90 q is exact
 	const double s = std::sin(r), c = std::cos(r);
+	std::pair<double, double> out;
 	switch ((static_cast<int>(quadrant) % 4 + 4) % 4) {
-		case 0: return {s, c};
-		case 1: return {c, -s};
-		case 2: return {-s, -c};
-		default: return {-c, s};
+		case 0: out = {s, c}; break;
+		case 1: out = {c, -s}; break;
+		case 2: out = {-s, -c}; break;
+		default: out = {-c, s}; break;
 	}
+	return {out.first + 0.0, out.second + 0.0};  // + 0.0: -0 becomes 0
 }
 
 [[noreturn]] void badJoint(int index, const std::string& what) {
