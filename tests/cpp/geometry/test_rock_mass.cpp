@@ -1,4 +1,4 @@
-// Tests of the rock-mass cutter's exact predicates (dda/geometry/PlanePredicates.hpp)
+// Tests of the rock-mass cutter: its exact predicates (dda/geometry/PlanePredicates.hpp), cells, slivers
 // and of its keyed random choices (RockPlanes.hpp).
 //
 // The oracle never reuses the library's formula: the side of plane l at the
@@ -9,6 +9,7 @@
 #include "dda/core/Errors.hpp"
 #include "dda/geometry/ConvexCell.hpp"
 #include "dda/geometry/PlanePredicates.hpp"
+#include "dda/geometry/RockMassSlivers.hpp"
 #include "dda/geometry/RockPlanes.hpp"
 
 #include <CGAL/Gmpq.h>
@@ -17,6 +18,7 @@
 #include <cmath>
 #include <iostream>
 #include <random>
+#include <string>
 #include <vector>
 
 namespace {
@@ -257,6 +259,59 @@ TEST(RockMassCells, SplitThroughCorners) {
 	// clipping keeps the inside of a face ref, or nothing
 	EXPECT_FALSE(clip(box, faceRef(0, false), table).has_value());  // inside x <= 0: no volume
 	EXPECT_DOUBLE_EQ(cellVolume(*clip(box, faceRef(6, true), table), table), 12);
+}
+
+}  // namespace
+
+namespace {
+
+// Slivers (RockMassSlivers.hpp): a thin slab S = [0, e] x [0, 1] x [0, 1] beside N = [e, 1] x [0, 1] x [0, 1]
+// merges (the union is the unit box); beside N1 = [e, 1] x [0, 0.5] and N2 = [e, 1] x [0.5, 1] it cannot
+// (either union is L-shaped) and is reported, with the reason.
+struct SlabScene {
+	std::vector<dda::rockmass::CutPlane> planes{
+	    {Vector3::UnitX(), -1}, {Vector3::UnitX(), 2}, {Vector3::UnitY(), -1}, {Vector3::UnitY(), 2},
+	    {Vector3::UnitZ(), -1}, {Vector3::UnitZ(), 2},  // bounds
+	    {Vector3::UnitX(), 0},  {Vector3::UnitX(), 1},  {Vector3::UnitY(), 0}, {Vector3::UnitY(), 1},
+	    {Vector3::UnitZ(), 0},  {Vector3::UnitZ(), 1},  // the unit box, 6..11
+	    {Vector3::UnitX(), 1e-3}, {Vector3::UnitY(), 0.5}};  // 12: the slab's face, 13: y = 0.5
+	dda::rockmass::VertexTable table{planes};
+	dda::rockmass::Cell box;
+	SlabScene() {
+		using namespace dda::rockmass;
+		box = boxCell(0, {0, 1, 2, 3, 4, 5}, table);
+		for (int p = 6; p < 12; ++p) box = *clip(box, faceRef(p, p % 2 == 0), table);
+	}
+	dda::rockmass::Cell clipped(const dda::rockmass::Cell& c, int plane, bool above) {
+		return *dda::rockmass::clip(c, dda::rockmass::faceRef(plane, above), table);
+	}
+};
+
+TEST(RockMassSlivers, ThinSlabMergesWithItsSibling) {
+	using namespace dda::rockmass;
+	SlabScene s;
+	const Cell slab = s.clipped(s.box, 12, false), rest = s.clipped(s.box, 12, true);
+	const auto problem = [&](const Cell& c) { return cellVolume(c, s.table) < 0.01 ? std::string("small") : std::string(); };
+	SliverOutcome out = mergeSlivers({slab, rest}, {s.box}, problem, s.table);
+	ASSERT_EQ(out.kept.size(), 1u);
+	EXPECT_TRUE(out.reported.empty());
+	EXPECT_EQ(out.merged, 1);
+	EXPECT_DOUBLE_EQ(cellVolume(out.kept[0], s.table), 1);
+	EXPECT_EQ(out.kept[0].faceCount(), 6);
+}
+
+TEST(RockMassSlivers, SlabBesideTwoBlocksIsReported) {
+	using namespace dda::rockmass;
+	SlabScene s;
+	const Cell slab = s.clipped(s.box, 12, false), rest = s.clipped(s.box, 12, true);
+	const Cell n1 = s.clipped(rest, 13, false), n2 = s.clipped(rest, 13, true);
+	const auto problem = [&](const Cell& c) { return cellVolume(c, s.table) < 0.01 ? std::string("small") : std::string(); };
+	SliverOutcome out = mergeSlivers({slab, n1, n2}, {s.box}, problem, s.table);
+	EXPECT_EQ(out.kept.size(), 2u);
+	EXPECT_EQ(out.merged, 0);
+	ASSERT_EQ(out.reported.size(), 1u);
+	EXPECT_NEAR(cellVolume(out.reported[0].first, s.table), 1e-3, 1e-15);
+	EXPECT_NE(out.reported[0].second.find("not convex"), std::string::npos) << out.reported[0].second;
 }
 
 }  // namespace
