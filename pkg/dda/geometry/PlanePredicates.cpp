@@ -11,6 +11,8 @@
 #include <CGAL/determinant.h>
 #include <gmp.h>
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 
 namespace dda::rockmass {
@@ -61,19 +63,26 @@ int sideFromDeterminants(const std::vector<CutPlane>& planes, const PlaneTriple&
 	return -sm * sn;
 }
 
-// Exact value m 2^e of a Gmpzf quotient, rounded toward zero to a double.
+// The exact quotient of two Gmpzf (m 2^e each) rounded toward zero to a
+// double: the integer quotient Q of the mantissas, shifted to at least 64
+// significant bits, truncated toward zero (mpz_tdiv_q), then to 53 bits
+// (mpz_get_d truncates), then scaled by a power of two (exact). Truncating
+// to an integer first loses nothing the 53-bit truncation keeps. No gcd, as
+// mpq would need.
 double quotientTowardZero(const Exact& numerator, const Exact& denominator) {
-	mpq_t q;
-	mpq_init(q);
-	mpq_set_num(q, numerator.man());
-	mpq_set_den(q, denominator.man());
-	mpq_canonicalize(q);
-	const long shift = numerator.exp() - denominator.exp();
-	if (shift > 0) mpq_mul_2exp(q, q, static_cast<mp_bitcnt_t>(shift));
-	if (shift < 0) mpq_div_2exp(q, q, static_cast<mp_bitcnt_t>(-shift));
-	const double value = mpq_get_d(q);
-	mpq_clear(q);
-	return value;
+	if (signOf(numerator) == 0) return 0;
+	mpz_t a, b, q;
+	mpz_init(a), mpz_init(b), mpz_init(q);
+	mpz_abs(a, numerator.man());
+	mpz_abs(b, denominator.man());
+	const long bitsA = static_cast<long>(mpz_sizeinbase(a, 2)), bitsB = static_cast<long>(mpz_sizeinbase(b, 2));
+	const long shift = std::max(0L, 66 + bitsB - bitsA);
+	mpz_mul_2exp(a, a, static_cast<mp_bitcnt_t>(shift));
+	mpz_tdiv_q(q, a, b);
+	const double truncated = mpz_get_d(q);
+	mpz_clear(a), mpz_clear(b), mpz_clear(q);
+	const double value = std::ldexp(truncated, static_cast<int>(numerator.exp() - denominator.exp() - shift));
+	return signOf(numerator) * signOf(denominator) < 0 ? -value : value;
 }
 
 std::string tripleText(const PlaneTriple& t) {

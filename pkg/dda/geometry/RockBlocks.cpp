@@ -12,7 +12,6 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <map>
 #include <numeric>
 
 namespace dda::rockmass {
@@ -49,7 +48,14 @@ int findRoot(std::vector<int>& parent, int i) {
 
 // Pairs of points closer than `tolerance`, found through a grid of that cell size.
 std::vector<std::pair<int, int>> closePairs(const std::vector<Vector3>& points, double tolerance) {
-	std::map<std::array<long long, 3>, std::vector<int>> grid;
+	struct CellHash {
+		std::size_t operator()(const std::array<long long, 3>& c) const {
+			std::uint64_t h = 0x9e3779b97f4a7c15ULL;
+			for (long long v : c) h = (h ^ static_cast<std::uint64_t>(v)) * 0x100000001b3ULL;
+			return static_cast<std::size_t>(h ^ (h >> 29));
+		}
+	};
+	std::unordered_map<std::array<long long, 3>, std::vector<int>, CellHash> grid;
 	const auto cellOf = [tolerance](const Vector3& p) {
 		std::array<long long, 3> c;
 		for (int k = 0; k < 3; ++k)

@@ -85,6 +85,10 @@ Cell mergedCell(const Cell& partCell, const Cell& a, const Cell& b, int plane, V
 	return cell;
 }
 
+bool boxesTouch(const Cell& a, const Cell& b) {
+	return (a.lo.array() <= b.hi.array()).all() && (b.lo.array() <= a.hi.array()).all();
+}
+
 struct Neighbour {
 	double area;
 	int cell;
@@ -101,7 +105,7 @@ std::vector<Neighbour> neighboursOf(int s, const std::vector<Cell>& cells, const
 		const auto found = byPlane.find(refPlane(ref));
 		if (found == byPlane.end()) continue;
 		for (int c : found->second) {
-			if (c == s || !alive[c] || cells[c].part != cell.part) continue;
+			if (c == s || !alive[c] || cells[c].part != cell.part || !boxesTouch(cell, cells[c])) continue;
 			const auto& refs = cells[c].faceRefs;
 			const auto g = std::find(refs.begin(), refs.end(), ref ^ 1);
 			if (g == refs.end()) continue;

@@ -398,3 +398,19 @@ def test_bad_options_are_refused_by_name():
         cutRockMass(CUBE, ORTHOGONAL, seed=1.5)
     with pytest.raises(ValueError, match='minVolume must be >= 0'):
         cutRockMass(CUBE, ORTHOGONAL, minVolume=-1)
+
+
+def test_the_garbage_collector_is_put_back_as_it_was():
+    import gc
+    assert gc.isenabled()
+    cutRockMass(CUBE, ORTHOGONAL)
+    assert gc.isenabled()
+    gc.disable()
+    try:
+        cutRockMass(CUBE, ORTHOGONAL)
+        assert not gc.isenabled()
+        with pytest.raises(ValueError):
+            cutRockMass(CUBE, [dict(dip=100, dipDirection=0, spacing=1)])
+        assert not gc.isenabled()
+    finally:
+        gc.enable()
