@@ -56,7 +56,8 @@ JointSpec jointOf(const py::dict& d) {
 		if (kind == "plane") spec.persistence = py::extract<double>(d["persistence"]);
 	} else if (kind == "excavateRegion") {
 		spec.kind = JointSpec::Kind::ExcavateRegion;
-		spec.corners = pointsOf(d["corners"]);
+		const py::object regions = d["regions"];
+		for (long r = 0, n = py::len(regions); r < n; ++r) spec.regions.push_back(pointsOf(regions[r]));
 	} else {
 		throw InputError("unknown joint kind '" + kind + "'");
 	}

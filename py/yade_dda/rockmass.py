@@ -215,6 +215,17 @@ def _pointNormal(value, where, name):
     return point, normal
 
 
+def _region(corners, where, r):
+    try:
+        corners = list(corners)
+    except TypeError:
+        raise ValueError('%s: excavated region %d must be a list of corners, got %r' % (where, r, corners)) from None
+    if len(corners) < 4:
+        raise ValueError('%s: excavated region %d has %d corners: a convex region needs at least 4' % (where, r,
+                                                                                                     len(corners)))
+    return [_point(p, '%s: excavated region %d, corner %d' % (where, r, j)) for j, p in enumerate(corners)]
+
+
 def _joint(entry, i):
     """One entry of jointSets, normalised for _core.cutRockMass."""
     where = 'jointSets[%d]' % i
@@ -223,16 +234,18 @@ def _joint(entry, i):
                          % (where, entry))
     if 'excavate' in entry:
         _unknownKeys(entry, _EXCAVATE_KEYS, where)
-        value = entry['excavate']
         try:
-            count = len(value)
+            items = list(entry['excavate'])
         except TypeError:
-            count = -1
-        if count >= 4:
-            return dict(kind='excavateRegion',
-                        corners=[_point(p, '%s: excavate corner %d' % (where, j)) for j, p in enumerate(value)])
-        point, normal = _pointNormal(value, where, 'excavate')
-        return dict(kind='excavate', point=point, normal=normal)
+            items = []
+        if len(items) == 2 and all(_isPoint(p) for p in items):      # (point, normal): a half-space
+            point, normal = _pointNormal(items, where, 'excavate')
+            return dict(kind='excavate', point=point, normal=normal)
+        if not items:
+            raise ValueError('%s: excavate must be (point, normal), a convex corner list or a list of them, got %r'
+                             % (where, entry['excavate']))
+        regions = [items] if _isPoint(items[0]) else items
+        return dict(kind='excavateRegion', regions=[_region(region, where, r) for r, region in enumerate(regions)])
     if 'plane' in entry:
         _unknownKeys(entry, _PLANE_KEYS, where)
         point, normal = _pointNormal(entry['plane'], where, 'plane')
@@ -262,7 +275,8 @@ def cutRockMass(domain, jointSets=(), seed=0, minVolume=None, checkShapes=True):
           ``spacing / 2``);
         - a single joint ``dict(plane=(point, normal))`` (optional ``persistence``);
         - an excavation ``dict(excavate=(point, normal))``: removes the side the normal points to; or
-          ``dict(excavate=corners)``: removes the convex hull of the corners (blocks crossing its surface
+          ``dict(excavate=corners)``: removes the convex hull of the corners, ``dict(excavate=[corners, ...])``
+          the union of several such regions (blocks crossing a region's surface
           are cut by its face planes, only they).
     :param seed: an int: every random choice (Fisher poles, random spacings, non-persistent cuts) is a
         hash of it and what it is for, so the same seed gives bitwise the same blocks.

@@ -211,7 +211,7 @@ std::vector<Cell> excavateAll(std::vector<Cell> cells, const Setup& setup, Verte
 		}
 		std::size_t end = p + 1;
 		while (end < setup.records.size() && setup.records[end].kind == PlaneKind::Excavation &&
-		       setup.records[end].source == r.source)
+		       setup.records[end].source == r.source && setup.records[end].region == r.region)
 			++end;
 		cells = excavate(std::move(cells), static_cast<int>(p), static_cast<int>(end), setup, table);
 		p = end;

@@ -43,7 +43,7 @@ std::pair<double, double> sinCosDegrees(double degrees) {
 }
 
 [[noreturn]] void badJoint(int index, const std::string& what) {
-	throw InputError("joint set " + std::to_string(index) + ": " + what);
+	throw InputError("jointSets[" + std::to_string(index) + "]: " + what);
 }
 
 void requireFinite(int index, const Vector3& v, const char* name) {
@@ -224,11 +224,16 @@ void appendJointPlanes(const JointSpec& spec, int index, const DomainExtent& dom
 		}
 		case JointSpec::Kind::ExcavateRegion: {
 			record.kind = PlaneKind::Excavation;
-			const auto faces = convexFacePlanes(spec.corners, "joint set " + std::to_string(index) + " (excavated region)");
-			for (std::size_t f = 0; f < faces.size(); ++f) {
-				record.plane = faces[f];
-				record.number = static_cast<int>(f);
-				out.push_back(record);
+			if (spec.regions.empty()) badJoint(index, "an excavation needs a region");
+			for (std::size_t r = 0; r < spec.regions.size(); ++r) {
+				const auto faces = convexFacePlanes(spec.regions[r], "jointSets[" + std::to_string(index) +
+				                                                         "] (excavated region " + std::to_string(r) + ")");
+				record.region = static_cast<int>(r);
+				for (std::size_t f = 0; f < faces.size(); ++f) {
+					record.plane = faces[f];
+					record.number = static_cast<int>(f);
+					out.push_back(record);
+				}
 			}
 			return;
 		}

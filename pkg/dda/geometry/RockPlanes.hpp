@@ -32,7 +32,7 @@ struct JointSpec {
 		Set,                // a family of planes (dip, dipDirection, spacing, origin, ...)
 		Plane,              // one joint through `point` with normal `normal`
 		ExcavateHalfSpace,  // removes n . (x - point) > 0
-		ExcavateRegion,     // removes the convex hull of `corners`
+		ExcavateRegion,     // removes the convex hull of each corner list of `regions`
 	};
 	Kind kind = Kind::Set;
 	double dip = 0;           // [deg], 0..90
@@ -45,7 +45,7 @@ struct JointSpec {
 	double spacingStd = 0;    // [m], standard deviation of lognormal spacings
 	Vector3 point = Vector3::Zero();   // Plane, ExcavateHalfSpace [m]
 	Vector3 normal = Vector3::UnitZ(); // Plane, ExcavateHalfSpace
-	std::vector<Vector3> corners;      // ExcavateRegion [m]
+	std::vector<std::vector<Vector3>> regions;  // ExcavateRegion: convex corner lists [m]
 };
 
 // What a plane of the cut is.
@@ -57,6 +57,7 @@ struct PlaneRecord {
 	PlaneKind kind = PlaneKind::Bound;
 	int source = -1;  // Domain: part; JointSet, Joint, Excavation: index in the joint list
 	int number = 0;   // JointSet: plane number k along the pole (0 through origin); Domain, region: face
+	int region = 0;   // Excavation: which region of the entry
 	double persistence = 1;
 	// Planes of one family share their normal bit for bit and come in
 	// ascending offset (a joint set without Fisher scatter); -1: none.

@@ -317,6 +317,15 @@ def test_excavations_remove_a_half_space_and_a_region():
     assert 'excavation' in kinds
 
 
+def test_an_excavation_of_two_regions_removes_both():
+    tunnels = [box((4.5, -1, 1), (7.5, 13, 4)), box((-1, 4.5, 7), (13, 7.5, 10))]
+    rock = cutRockMass(CUBE, ORTHOGONAL + [dict(excavate=tunnels)])
+    assert sum(b.volume for b in rock) == pytest.approx(1728 - 2 * 3 * 12 * 3, rel=1e-12)
+    regions = {(rock.planes[p].source, rock.planes[p].number) for b in rock for p in b.planes
+               if rock.planes[p].kind == 'excavation'}
+    assert regions and all(source == 3 for source, _ in regions)
+
+
 def test_a_sliver_merges_into_its_neighbour():
     rock = cutRockMass(CUBE, [dict(plane=((1e-4, 0, 0), (1, 0, 0)))], minVolume=1.0)
     assert len(rock) == 1 and rock.merged == 1 and not rock.slivers
@@ -381,11 +390,13 @@ def test_the_12m_cube_stack_rests_on_a_fixed_floor(scene, rigid):
     (CUBE, [dict(dip=30, dipDirection=0, spacing=1, spacingDistribution='uniform')], 'spacingDistribution'),
     (CUBE, [dict(dip=math.nan, dipDirection=0, spacing=1)], 'finite'),
     (CUBE, [dict(dip=30, dipDirection=0, spacing=1, origin=(0, math.inf, 0))], 'finite'),
-    (CUBE, [dict(dip=30, dipDirection=0, spacing=1e-6)], 'planes across the domain'),
+    (CUBE, [dict(dip=30, dipDirection=0, spacing=1e-6)], r'jointSets\[0\]: spacing 1e-06 m puts about .* planes across'),
     (CUBE, [dict(plane=((0, 0, 0), (0, 0, 0)))], 'normal must not be zero'),
     (CUBE, [dict(plane=((0, 0, 0), (0, 0, 1)), spacing=3)], "unknown key 'spacing'"),
-    (CUBE, [dict(excavate=[(0, 0, 0)] * 3)], 'excavate'),
-    (CUBE, [dict(excavate=CUBE[:3] + [(1, 1, 0)])], 'excavated region'),
+    (CUBE, [dict(excavate=[(0, 0, 0)] * 3)], 'excavated region 0 has 3 corners'),
+    (CUBE, [dict(excavate=CUBE[:3] + [(1, 1, 0)])], r'jointSets\[0\] \(excavated region 0\): all 4 points are coplanar'),
+    (CUBE, [dict(excavate=[CUBE, CUBE[:3] + [(1, 1, 0)]])], r'excavated region 1\): all 4 points'),
+    (CUBE, [dict(excavate=5)], 'excavate must be'),
     (CUBE, ['dip 30'], 'must be a dict'),
 ])
 def test_bad_input_is_refused_by_name(domain, joints, message):
