@@ -22,7 +22,8 @@
 //      points to, a convex region its inside (blocks crossing its boundary
 //      are cut by its face planes, only they);
 //   4. corners closer than 1e-12 x the domain's diagonal are made one
-//      (CornerSnap, RockBlocks.hpp: round-off of the input, never a feature);
+//      (CornerSnap, RockBlocks.hpp: round-off of the input, far below any
+//      real feature);
 //   5. blocks below minVolume, or whose corners buildConvexPolyhedron (hence
 //      ddaBlock) would refuse, are merged into a neighbour they share a face
 //      with, the largest shared face first, when the union is convex

@@ -369,6 +369,72 @@ def test_the_12m_cube_stack_rests_on_a_fixed_floor(scene, rigid):
     assert moved < bound and speed < 0.01
 
 
+# ---------------------------------------------------------------- random domains and sets
+
+def _rotated(p, axis, angle):
+    n = math.sqrt(sum(x * x for x in axis))
+    k = [x / n for x in axis]
+    c, s = math.cos(angle), math.sin(angle)
+    kxv = (k[1] * p[2] - k[2] * p[1], k[2] * p[0] - k[0] * p[2], k[0] * p[1] - k[1] * p[0])
+    kv = sum(k[i] * p[i] for i in range(3))
+    return tuple(p[i] * c + kxv[i] * s + k[i] * kv * (1 - c) for i in range(3))
+
+
+def _randomCase(seed):
+    """A random domain (box, turned box or hull of a Gaussian cloud) and 1 to 4 joint sets, half of
+    their angles 'nice' (0, 15, 30, 45, ... 90: exact identities between them, rounded), some through a
+    corner of the domain, some persistent, scattered or randomly spaced."""
+    rng = random.Random(seed)
+    size = rng.choice([1, 10, 12, 100])
+    kind = rng.random()
+    if kind < 0.4:
+        domain = box((0, 0, 0), (size, size * rng.choice([0.5, 1, 2]), size))
+    elif kind < 0.7:
+        axis, angle = (rng.random(), rng.random(), rng.random()), rng.uniform(0, 3)
+        domain = [_rotated(p, axis, angle) for p in box((0, 0, 0), (size, size, size))]
+    else:
+        cloud = [(rng.gauss(0, size), rng.gauss(0, size), rng.gauss(0, size)) for _ in range(12)]
+        domain = [cloud[i] for i in yade_dda._core.hullCorners(cloud)]
+    nice = [0, 15, 20, 30, 40, 45, 60, 70, 75, 90]
+    sets = []
+    for _ in range(rng.randint(1, 4)):
+        entry = dict(dip=rng.choice(nice) if rng.random() < 0.5 else rng.uniform(0, 90),
+                     dipDirection=rng.choice(nice + [180, 270, 360]) if rng.random() < 0.5 else rng.uniform(0, 360),
+                     spacing=size / rng.choice([2, 3, 4, 5]),
+                     origin=domain[0] if rng.random() < 0.3 else tuple(rng.uniform(-size, size) for _ in range(3)))
+        r = rng.random()
+        if r < 0.2:
+            entry.update(persistence=rng.uniform(0.2, 1))
+        elif r < 0.35:
+            entry.update(fisherK=rng.uniform(5, 100))
+        elif r < 0.45:
+            entry.update(spacingDistribution=rng.choice(['exponential', 'lognormal']))
+        sets.append(entry)
+    return domain, sets
+
+
+def _checkRandomCases(seeds):
+    for seed in seeds:
+        domain, sets = _randomCase(seed)
+        rock = cutRockMass(domain, sets, seed=seed)
+        try:
+            checkVolume(rock)
+            for b in rock:   # what ddaBlock checks of the corners (without making YADE bodies)
+                yade_dda._core.checkBlock(b.corners, 2600.0, 1e9, 0.25)
+        except (AssertionError, ValueError):
+            print('seed', seed, domain, sets)
+            raise
+
+
+def test_random_domains_and_sets_conserve_volume_and_give_valid_blocks():
+    _checkRandomCases(range(150))
+
+
+@pytest.mark.slow
+def test_random_domains_and_sets_many():
+    _checkRandomCases(range(150, 3150))
+
+
 # ---------------------------------------------------------------- bad input
 
 @pytest.mark.parametrize('domain, joints, message', [
