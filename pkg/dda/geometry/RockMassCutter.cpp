@@ -178,26 +178,37 @@ std::vector<Cell> cutFamily(std::vector<Cell> cells, const Family& family, const
 	return out;
 }
 
+// Whether the cell and the region of outward face planes [first, last) share
+// volume: the cell clipped by every face plane keeps some (exact).
+bool meetsRegion(const Cell& cell, int first, int last, const Setup& setup, VertexTable& table) {
+	for (int plane = first; plane < last; ++plane)
+		if (boxRange(setup.planes[plane], cell.lo, cell.hi)[0] >= 0) return false;  // wholly outside a face
+	std::optional<Cell> common = cell;
+	for (int plane = first; plane < last && common; ++plane) common = clip(*common, faceRef(plane, false), table);
+	return common.has_value();
+}
+
 // The cells outside one excavated region, whose outward face planes are
-// records [first, last) (a half-space is a region with one face).
+// records [first, last) (a half-space is a region with one face). A cell
+// that shares no volume with the region is kept whole; one that does is cut
+// by the region's face planes in turn, each part outside a plane kept, and
+// what is left inside all of them removed: the region's planes cut only the
+// blocks it reaches.
 std::vector<Cell> excavate(std::vector<Cell> cells, int first, int last, const Setup& setup, VertexTable& table) {
 	std::vector<Cell> out;
 	std::vector<signed char> signs;
 	for (Cell& cell : cells) {
+		if (!meetsRegion(cell, first, last, setup, table)) {
+			out.push_back(std::move(cell));
+			continue;
+		}
 		Cell rest = std::move(cell);
-		bool inside = true;
-		for (int plane = first; plane < last && inside; ++plane) {
-			const auto range = boxRange(setup.planes[plane], rest.lo, rest.hi);
-			if (range[0] >= 0) inside = false;  // wholly outside this face: kept whole
-			if (!inside || range[1] <= 0) continue;
-			const int mask = classify(rest, plane, table, signs);
-			if (!(mask & 1)) inside = false;
-			if (mask != 3) continue;
+		for (int plane = first; plane < last; ++plane) {
+			if (classify(rest, plane, table, signs) != 3) continue;  // wholly inside this face: next face
 			auto parts = split(rest, plane, signs, table);
 			out.push_back(std::move(parts.second));
 			rest = std::move(parts.first);
 		}
-		if (!inside) out.push_back(std::move(rest));
 	}
 	return out;
 }

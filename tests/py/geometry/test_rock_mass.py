@@ -315,6 +315,11 @@ def test_excavations_remove_a_half_space_and_a_region():
         assert not (4.5 < centre[0] < 7.5 and 1 < centre[2] < 4)
     kinds = {rock.planes[p].kind for b in rock for p in b.planes}
     assert 'excavation' in kinds
+    # the region's face planes cut only blocks that reach into the region: none of those above z = 6
+    for b in rock:
+        if min(c[2] for c in b.corners) >= 6:
+            assert all(rock.planes[p].kind != 'excavation' for p in b.planes if rock.planes[p].source == 4), b
+    assert len([b for b in rock if min(c[2] for c in b.corners) >= 6]) == 4 * 3   # (the half-space took z > 9)
 
 
 def test_an_excavation_of_two_regions_removes_both():
