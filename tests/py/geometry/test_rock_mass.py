@@ -374,6 +374,31 @@ def test_the_12m_cube_stack_rests_on_a_fixed_floor(scene, rigid):
     assert moved < bound and speed < 0.01
 
 
+@pytest.mark.xfail(reason='core, not the cut: blocks that the cut makes flush and slender (oblique sets with the planes '
+                          'x = 5 and z = 8) get contacts with gaps of -10 to -13 m in the first step, then speeds of '
+                          '1e3 m/s. The scene has no overlap (the core\'s initial-overlap check passes), and detectPair '
+                          'at the start types e.g. the pair of bodies 124 and 81 EEp, normal (0, 0, 1), gap 0, where the '
+                          'step\'s contact list has it FF, normal (0, -1, 0), gap -10.94 m',
+                   strict=False)
+def test_a_jointed_cube_with_flush_slender_blocks_starts_at_rest(scene):
+    """A 16 m cube cut by three oblique sets and the planes x = 5 and z = 8, its surface blocks held:
+    the first step finds no contact deeper than 1 mm. A reproducer for the core."""
+    side = 16.0
+    sets = [dict(dip=60, dipDirection=80, spacing=2.0, origin=(0.4, 0.3, 0.2)),
+            dict(dip=55, dipDirection=265, spacing=2.5, origin=(0.4, 0.3, 0.2)),
+            dict(dip=10, dipDirection=170, spacing=2.0, origin=(0.4, 0.3, 0.2)),
+            dict(plane=((5, 0, 0), (1, 0, 0))), dict(plane=((0, 0, 8), (0, 0, 1)))]
+    rock = cutRockMass(box((0, 0, 0), (side, side, side)), sets, seed=7, minVolume=0.05)
+    mat = material(O, young=1e9, frictionDeg=30)
+    surface = [any(c[k] in (0.0, side) for c in b.corners for k in range(3)) for b in rock]
+    ids = [O.bodies.append(ddaBlock(b.corners, material=mat, fixed=f)) for b, f in zip(rock, surface)]
+    free = {i for i, f in zip(ids, surface) if not f}
+    O.engines = [DDAIntegrator(dt=2e-3, gravity=(0, 0, -9.81), maxDisplacement=0.01, label='dda')]
+    O.run(1, True)
+    deep = [(c.id1, c.id2, c.type, c.gap) for c in yade_dda.contacts() if c.gap < -1e-3 and {c.id1, c.id2} & free]
+    assert not deep, deep[:4]
+
+
 # ---------------------------------------------------------------- random domains and sets
 
 def _rotated(p, axis, angle):
