@@ -229,9 +229,4 @@ double cellVolume(const Cell& cell, VertexTable& table) {
 	return six / 6;
 }
 
-std::size_t cellBytes(const Cell& cell) {
-	return sizeof(int) * (cell.vertices.capacity() + cell.faceRefs.capacity() + cell.faceStart.capacity() +
-	                      cell.corners.capacity());
-}
-
 }  // namespace dda::rockmass

@@ -88,7 +88,4 @@ std::uint64_t cellKey(const Cell& cell);
 // Volume [m^3] from the rounded vertices (faces fanned from their first corner).
 double cellVolume(const Cell& cell, VertexTable& table);
 
-// Heap bytes a cell holds.
-std::size_t cellBytes(const Cell& cell);
-
 }  // namespace dda::rockmass

@@ -163,19 +163,4 @@ std::array<double, 2> boxRange(const CutPlane& plane, const Vector3& lo, const V
 	return {s.inf(), s.sup()};
 }
 
-bool samePlane(const CutPlane& a, const CutPlane& b) {
-	const std::array<double, 4> x{a.normal.x(), a.normal.y(), a.normal.z(), a.offset};
-	const std::array<double, 4> y{b.normal.x(), b.normal.y(), b.normal.z(), b.offset};
-	{
-		CGAL::Protect_FPU_rounding<true> guard;
-		for (int i = 0; i < 4; ++i)
-			for (int j = i + 1; j < 4; ++j)
-				if (signOf(Interval(x[i]) * Interval(y[j]) - Interval(x[j]) * Interval(y[i])) != 2) return false;
-	}
-	for (int i = 0; i < 4; ++i)
-		for (int j = i + 1; j < 4; ++j)
-			if (signOf(Exact(x[i]) * Exact(y[j]) - Exact(x[j]) * Exact(y[i])) != 0) return false;
-	return true;
-}
-
 }  // namespace dda::rockmass

@@ -80,8 +80,4 @@ Vector3 vertexPoint(const std::vector<CutPlane>& planes, const PlaneTriple& t);
 // Certain range [lo, hi] of n . x - offset over the box lo <= x <= hi.
 std::array<double, 2> boxRange(const CutPlane& plane, const Vector3& lo, const Vector3& hi);
 
-// Two planes are the same set of points (equal or opposite orientation),
-// decided exactly: every 2x2 minor of [n1 d1; n2 d2] is zero.
-bool samePlane(const CutPlane& a, const CutPlane& b);
-
 }  // namespace dda::rockmass

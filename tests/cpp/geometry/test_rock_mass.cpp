@@ -187,12 +187,6 @@ TEST(RockMassPredicates, VertexPointIsTheExactPointRoundedTowardZero) {
 	EXPECT_EQ(triples, 3);
 }
 
-TEST(RockMassPredicates, SamePlaneIsExact) {
-	EXPECT_TRUE(dda::rockmass::samePlane({Vector3(1, 2, 3), 4}, {Vector3(-2, -4, -6), -8}));
-	EXPECT_FALSE(dda::rockmass::samePlane({Vector3(1, 2, 3), 4}, {Vector3(1, 2, 3), std::nextafter(4.0, 5.0)}));
-	EXPECT_FALSE(dda::rockmass::samePlane({Vector3(1, 2, 3), 4}, {Vector3(1, 2, std::nextafter(3.0, 4.0)), 4}));
-}
-
 TEST(RockMassPlanes, PoleConvention) {
 	// dip 30 towards the east (+x): the pole leans west-up... i.e. its x part is +sin 30, and the plane
 	// descends towards +x: moving along +x on it, z falls.
