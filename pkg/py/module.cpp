@@ -413,6 +413,7 @@ BOOST_PYTHON_MODULE(_core) {
 	        "IntegratorSettings attribute; None for the engine's own), kind, default, range (its text), low, high, "
 	        "lowOpen, highOpen (numbers) or choices (names), unit, doc.");
 	py::def("colliderNames", &pythonColliderNames, "The broad phases of the core, by name (DESS first, the default).");
+	void registerRockMass(); registerRockMass();  // cutRockMass and its predicates (pkg/py/RockMass.cpp)
 
 	py::class_<IntegratorSettings> settingsClass(
 	    "IntegratorSettings", "Parameters of one DDA step (pkg/dda/solver/Settings.def; DDAIntegrator's docstring).");
