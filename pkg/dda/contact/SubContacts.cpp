@@ -216,22 +216,43 @@ bool besideVertexContact(const SubContact& crossing, const std::vector<SubContac
 // for q outside `other` it is positive (some face plane separates a point
 // from a convex block), for q inside it is minus q's distance to the
 // boundary, which a translation of the penetration depth carries q across.
+//
+// Internal faces (a fixed block's faces covered whole by a flush fixed
+// neighbour, markInternalFaces) are no entrance, but they count in finding
+// how far q lies outside `other`: the farthest-above face over all faces.
+// When an internal face beats every other face by more than `reach` (the
+// contact distance), q lies across it, on the neighbour's side, farther
+// than a contact's reach from `other`'s exposed surface: q touches the
+// fixed mass there through the neighbour's faces, which the neighbour's own
+// pair finds, and this pair gives it no contact. Within `reach` (a corner at
+// the seam of a flush floor, on the plane of the two blocks' shared face and
+// a little below their tops) both blocks hold it, as they always did, and
+// share its load. Before, the best face among the others was taken whatever
+// its distance, and a corner touching a fixed block only where that block's
+// faces are internal was measured against its one outer face, metres away
+// across the block (gaps of -2 to -4 m in a jointed 16 m cube;
+// tests/py/geometry/test_rock_mass.py). A contact left out carries no
+// spring, so leaving it out creates no energy; the one it replaces pushed
+// with a spring stretched by metres. A contact kept has a gap of at least
+// the farthest distance less `reach`: above -reach for q outside `other`.
 void ownEntranceContact(const Prepared& block, bool blockIsA, int q, const Prepared& other, double reach,
                         std::vector<SubContact>& out) {
 	const Vector3& x = block.corner(q);
 	int bestFace = -1;
-	double bestDistance = -std::numeric_limits<double>::infinity();
+	double bestDistance = -std::numeric_limits<double>::infinity();  // over the entrance-eligible faces
+	double farthest = -std::numeric_limits<double>::infinity();     // over all faces
 	for (int g = 0; g < other.faceCount(); ++g) {
-		if (other.internal(g)) continue;
 		++*block.tests;
 		ensurePlane(other, g);
 		const double d = planeDistance(other, g, x);
+		farthest = std::max(farthest, d);
+		if (other.internal(g)) continue;
 		if (d > bestDistance) {
 			bestDistance = d;
 			bestFace = g;
 		}
 	}
-	if (bestFace < 0 || bestDistance > reach) return;
+	if (bestFace < 0 || bestDistance > reach || bestDistance < farthest - reach) return;
 	if (!projectionNearFace(other, bestFace, x, reach)) return;
 	out.push_back(vertexFaceContact(blockIsA, block, q, other, bestFace));
 }

@@ -374,18 +374,12 @@ def test_the_12m_cube_stack_rests_on_a_fixed_floor(scene, rigid):
     assert moved < bound and speed < 0.01
 
 
-@pytest.mark.xfail(reason='core, not the cut: the first step stores contacts 2 to 4 m deep (FF or EF) between blocks '
-                          'that do not overlap: with dt = 1e-9, so that nothing moves, the step lists the pair of bodies '
-                          '268 and 281 as FF with gap -3.91 m where detectPair at the same geometry and settings finds '
-                          'VV with gap -1.4e-15 m. The free block touches the fixed one at one corner; all the fixed '
-                          'block\'s faces but x = 16 are flush with other fixed blocks (internal, skipped), and the narrow '
-                          'phase takes that outer face as the entrance. With no block fixed, or markInternalFaces '
-                          'skipped, there is none',
-                   strict=False)
 def test_a_jointed_cube_of_free_blocks_starts_at_rest(scene):
     """A 16 m cube cut by three oblique sets (293 blocks), those on the faces x = 0, x = 16 and z = 0 held
-    and 181 free: the first step finds no contact deeper than 1 mm. A reproducer for the core (doc/rock-mass.md,
-    "In a scene"); with startFromRest (the default) or without gravity the same contacts appear."""
+    and 181 free: the first step finds no contact deeper than 1 mm. It found contacts 2 to 4 m deep: a free
+    block's corner touching a fixed block only where that block's faces are flush with fixed neighbours
+    (internal) was measured against its one outer face, across the block (pkg/dda/contact/SubContacts.cpp,
+    ownEntranceContact)."""
     side = 16.0
     sets = [dict(dip=60, dipDirection=80, spacing=2.0, origin=(0.4, 0.3, 0.2)),
             dict(dip=55, dipDirection=265, spacing=2.5, origin=(0.4, 0.3, 0.2)),
@@ -402,6 +396,31 @@ def test_a_jointed_cube_of_free_blocks_starts_at_rest(scene):
     O.run(1, True)
     deep = [(c.id1, c.id2, c.type, c.gap) for c in yade_dda.contacts() if c.gap < -1e-3 and {c.id1, c.id2} & free]
     assert not deep, deep[:4]
+
+
+@pytest.mark.parametrize('seed', [1, 2, 3, 4])
+def test_no_contact_of_a_cut_rock_mass_is_deeper_than_its_blocks_overlap(scene, seed):
+    """Oracle: the blocks of a cut rock mass tile the domain exactly (shared faces bit for bit), so no two
+    overlap and no sub-contact of the first step may have a gap below minus the length tolerance, with any
+    choice of fixed blocks (their flush faces are marked internal and skipped as entrances). Random oblique
+    sets, seeded; the boundary blocks of random faces of the cube held."""
+    rng = random.Random(seed)
+    print('seed', seed)
+    side = 12.0
+    sets = [dict(dip=rng.uniform(5, 85), dipDirection=rng.uniform(0, 360), spacing=rng.uniform(2.5, 4.0),
+                 origin=(rng.uniform(0, 1), rng.uniform(0, 1), rng.uniform(0, 1))) for _ in range(3)]
+    rock = cutRockMass(box((0, 0, 0), (side, side, side)), sets, seed=seed)
+    planes = rng.sample([(0, 0.0), (0, side), (1, 0.0), (1, side), (2, 0.0), (2, side)], 3)
+    held = [any(c[k] == value for c in b.corners for k, value in planes) for b in rock]
+    assert 0 < sum(held) < len(rock)
+    mat = material(O, young=1e9, frictionDeg=30)
+    for b, h in zip(rock, held):
+        O.bodies.append(ddaBlock(b.corners, material=mat, fixed=h))
+    O.engines = [DDAIntegrator(dt=1e-9, gravity=(0, 0, -9.81), maxDisplacement=0.01, startFromRest=False)]
+    O.run(1, True)
+    gaps = [c.gap for c in yade_dda.contacts()]
+    assert gaps, 'the blocks touch'
+    assert min(gaps) >= -1e-6, (len(rock), sum(held), min(gaps))
 
 
 # ---------------------------------------------------------------- random domains and sets
