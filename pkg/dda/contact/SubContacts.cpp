@@ -236,7 +236,7 @@ bool besideVertexContact(const SubContact& crossing, const std::vector<SubContac
 // with a spring stretched by metres. A contact kept has a gap of at least
 // the farthest distance less `reach`: above -reach for q outside `other`.
 void ownEntranceContact(const Prepared& block, bool blockIsA, int q, const Prepared& other, double reach,
-                        std::vector<SubContact>& out) {
+                        double tolerance, std::vector<SubContact>& out) {
 	const Vector3& x = block.corner(q);
 	int bestFace = -1;
 	double bestDistance = -std::numeric_limits<double>::infinity();  // over the entrance-eligible faces
@@ -254,6 +254,17 @@ void ownEntranceContact(const Prepared& block, bool blockIsA, int q, const Prepa
 	}
 	if (bestFace < 0 || bestDistance > reach || bestDistance < farthest - reach) return;
 	if (!projectionNearFace(other, bestFace, x, reach)) return;
+	// q on or outside `other` where its nearest faces are internal, below the
+	// plane of an exposed face G beside them but beyond G's boundary (its
+	// projection on G's plane outside G): q did not come in through G, and
+	// the gap against G's plane measures no overlap (a wedge's corner sliding
+	// down the ridge edge of the fixed block below it, whose two faces there
+	// are covered by fixed neighbours, was 1.3 cm "below" that block's top
+	// face, beyond its corner; tests/py/system/test_wedge.py). A corner at the
+	// seam of a flush floor projects onto G's boundary and keeps its contact.
+	if (bestDistance < -tolerance && bestDistance < farthest - tolerance &&
+	    insideMargin(other, bestFace, x) < -tolerance)
+		return;
 	out.push_back(vertexFaceContact(blockIsA, block, q, other, bestFace));
 }
 
@@ -322,7 +333,7 @@ void faceEntranceContacts(const Prepared& owner, bool ownerIsA, int f, const Pre
 			}
 		}
 		if (coincident) continue;
-		ownEntranceContact(owner, ownerIsA, q, other, reach, out);
+		ownEntranceContact(owner, ownerIsA, q, other, reach, settings.lengthTolerance, out);
 	}
 
 	// Edges of the other block crossing the face's edges, no deeper than the
@@ -426,7 +437,7 @@ void cornersOfEdgeEntrance(const Prepared& a, int edgeA, const Prepared& b, int 
 				if (c.kind == ContactKind::VertexFace && c.firstIsA == blockIsA && c.feature1 == q) return true;
 				return (c.pointI - x).norm() <= merge || (c.pointJ - x).norm() <= merge;
 			});
-			if (!known) ownEntranceContact(block, blockIsA, q, other, reach, out);
+			if (!known) ownEntranceContact(block, blockIsA, q, other, reach, settings.lengthTolerance, out);
 		}
 	}
 }
