@@ -43,7 +43,7 @@ struct PairSum {
 };
 
 // The forces on block i from its closed contacts [N], their torques about
-// its centroid [N m], and the body pairs' sums; both in one pass.
+// its centroid [N m], and (when `pairs`) the body pairs' sums, in one pass.
 void contactSums(const SceneLink& s, std::vector<Vector3>* force, std::vector<Vector3>* torque,
                  std::map<std::pair<int, int>, PairSum>* pairs) {
 	const World& w = s.world;
@@ -54,12 +54,10 @@ void contactSums(const SceneLink& s, std::vector<Vector3>* force, std::vector<Ve
 		const BodyLink* lj = s.bodyLink(j);
 		if (!li || !lj) continue;
 		const Vector3 onI = c.geometry.normal * c.history.normalForce + c.history.shearForce;
-		if (force) {
-			(*force)[i] += onI;
-			(*force)[j] -= onI;
-			(*torque)[i] += (c.point - w.block(i).centroid).cross(onI);
-			(*torque)[j] -= (c.point - w.block(j).centroid).cross(onI);
-		}
+		(*force)[i] += onI;
+		(*force)[j] -= onI;
+		(*torque)[i] += (c.point - w.block(i).centroid).cross(onI);
+		(*torque)[j] -= (c.point - w.block(j).centroid).cross(onI);
 		if (!pairs) continue;
 		// Body order: id1 is the smaller body id. The normal n_k points from j
 		// to i: from id1 to id2 when i is id2.
@@ -84,29 +82,23 @@ void contactSums(const SceneLink& s, std::vector<Vector3>* force, std::vector<Ve
 
 }  // namespace
 
-std::vector<PairView> pairViews(const SceneLink& s) {
+ContactViews contactViews(const SceneLink& s, const IntegratorSettings& settings, bool withPairs) {
+	const World& w = s.world;
+	const int n = w.blockCount();
+	std::vector<Vector3> force(n, Vector3::Zero()), torque(n, Vector3::Zero());
 	std::map<std::pair<int, int>, PairSum> pairs;
-	contactSums(s, nullptr, nullptr, &pairs);
-	std::vector<PairView> out;
-	out.reserve(pairs.size());
+	contactSums(s, &force, &torque, withPairs ? &pairs : nullptr);
+	ContactViews out;
+	out.pairs.reserve(pairs.size());
 	for (const auto& [ids, p] : pairs) {
 		const Vector3 sum = p.weightedNormal.squaredNorm() > 0 ? p.weightedNormal : p.plainNormal;
 		const Vector3 normal = sum.squaredNorm() > 0 ? Vector3(sum.normalized()) : Vector3(Vector3::UnitZ());
 		const Vector3 normalForce = p.force.dot(normal) * normal;
 		const Vector3 point = p.weight > 0 ? Vector3(p.weightedPoint / p.weight) : Vector3(p.plainPoint / p.count);
-		out.push_back(PairView{ids.first, ids.second, point, normal, normalForce, Vector3(p.force - normalForce), p.kn,
-		                       p.ks, p.tanPhi});
+		out.pairs.push_back(PairView{ids.first, ids.second, point, normal, normalForce, Vector3(p.force - normalForce),
+		                             p.kn, p.ks, p.tanPhi});
 	}
-	return out;
-}
-
-std::vector<BodyForce> bodyForces(const SceneLink& s, const IntegratorSettings& settings) {
-	const World& w = s.world;
-	const int n = w.blockCount();
-	std::vector<Vector3> force(n, Vector3::Zero()), torque(n, Vector3::Zero());
-	contactSums(s, &force, &torque, nullptr);
-	std::vector<BodyForce> out;
-	out.reserve(n);
+	out.bodies.reserve(n);
 	for (int i = 0; i < n; ++i) {
 		const BodyLink* link = s.bodyLink(i);
 		if (!link) continue;
@@ -121,7 +113,7 @@ std::vector<BodyForce> bodyForces(const SceneLink& s, const IntegratorSettings& 
 			f += spring;
 			m += (point.position - b.centroid).cross(spring);
 		}
-		out.push_back(BodyForce{link->bodyId, f, m});
+		out.bodies.push_back(BodyForce{link->bodyId, f, m});
 	}
 	return out;
 }

@@ -154,8 +154,14 @@ void YadeSync::addForces(const std::vector<BodyForce>& target, const py::object&
 // or torque (a reset of the container, by a ForceResetter or a script,
 // zeroes every body at once, so it shows there), or the first block when all
 // are believed zero (then a reset changed nothing). Else every block is read.
-void YadeSync::writeForces(const SceneLink& s, const IntegratorSettings& settings, const py::object& forces) {
-	const std::vector<BodyForce> target = bodyForces(s, settings);
+int YadeSync::writeViews(const SceneLink& s, const IntegratorSettings& settings, const py::object& forces,
+                         const py::object& interactions, bool keep, const py::list& foreign) {
+	const ContactViews views = contactViews(s, settings, keep);
+	writeForces(views.bodies, forces);
+	return writeInteractions(views.pairs, interactions, keep, foreign);
+}
+
+void YadeSync::writeForces(const std::vector<BodyForce>& target, const py::object& forces) {
 	if (target.empty()) return;
 	// YADE's container (OpenMP build) keeps per-thread sums: f(id, True) sums them first.
 	forces.attr("f")(target.front().bodyId, true);
@@ -207,10 +213,9 @@ YadeSync::PairObjects YadeSync::pairObjects(const py::object& interactions, int 
 	return objects;
 }
 
-int YadeSync::writeInteractions(const SceneLink& s, const py::object& interactions, bool keep,
+int YadeSync::writeInteractions(const std::vector<PairView>& current, const py::object& interactions, bool keep,
                                 const py::list& foreign) {
 	const Names& n = names();
-	const std::vector<PairView> current = keep ? pairViews(s) : std::vector<PairView>();
 	std::map<std::pair<int, int>, PairObjects> kept;
 	for (const PairView& p : current) {
 		const std::pair<int, int> ids(p.id1, p.id2);

@@ -53,9 +53,13 @@ struct BodyForce {
 	Vector3 force, torque;
 };
 
-// Views.cpp: the pairs in body order, and one entry per linked block in block order.
-std::vector<PairView> pairViews(const SceneLink& s);
-std::vector<BodyForce> bodyForces(const SceneLink& s, const IntegratorSettings& settings);
+// Views.cpp, in one pass over the contacts: the pairs in body order (none
+// unless withPairs), and one entry per linked block in block order.
+struct ContactViews {
+	std::vector<PairView> pairs;
+	std::vector<BodyForce> bodies;
+};
+ContactViews contactViews(const SceneLink& s, const IntegratorSettings& settings, bool withPairs);
 
 class YadeSync {
 public:
@@ -67,12 +71,13 @@ public:
 	// angular velocity, and vertices when strained since the last write;
 	// returns how many bodies were written.
 	int writeBodies(SceneLink& s, const py::object& bodies, bool all);
-	// O.forces holds bodyForces (forces: O.forces).
-	void writeForces(const SceneLink& s, const IntegratorSettings& settings, const py::object& forces);
-	// O.interactions holds pairViews when keep (else none of them);
-	// foreign: DDA pairs already in O.interactions that this object did not
-	// make (a loaded scene's), erased unless current. Returns the pair count.
-	int writeInteractions(const SceneLink& s, const py::object& interactions, bool keep, const py::list& foreign);
+	// O.forces (forces) holds each block's force and torque, and
+	// O.interactions (interactions) the pairs' views when keep (else none of
+	// them); foreign: DDA pairs already in O.interactions that this object
+	// did not make (a loaded scene's), erased unless current. Returns the
+	// pair count.
+	int writeViews(const SceneLink& s, const IntegratorSettings& settings, const py::object& forces,
+	               const py::object& interactions, bool keep, const py::list& foreign);
 
 	void forgetBodies();        // a body's state or shape object was replaced
 	void forgetInteractions();                 // a script cleared the interactions
@@ -99,6 +104,9 @@ private:
 	const VertexList& vertexList(std::size_t count);
 	void setVector(PyObject* target, PyObject* name, const Vector3& value);
 	void addForces(const std::vector<BodyForce>& target, const py::object& forces, bool readBack);
+	void writeForces(const std::vector<BodyForce>& target, const py::object& forces);
+	int writeInteractions(const std::vector<PairView>& current, const py::object& interactions, bool keep,
+	                      const py::list& foreign);
 
 	py::object geomClass_, physClass_, createInteraction_;
 	py::object vector_, quaternion_;  // refilled for each setter call

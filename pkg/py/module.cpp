@@ -473,13 +473,13 @@ BOOST_PYTHON_MODULE(_core) {
 	    .def("writeBodies", &YadeSync::writeBodies, (py::arg("scene"), py::arg("bodies"), py::arg("all")),
 	         "Writes moving blocks' (every block's if all) pos, ori, vel, angVel and, when strained, vertices into "
 	         "their bodies (bodies: O.bodies); returns how many.")
-	    .def("writeForces", &YadeSync::writeForces, (py::arg("scene"), py::arg("settings"), py::arg("forces")),
+	    .def("writeViews", &YadeSync::writeViews,
+	         (py::arg("scene"), py::arg("settings"), py::arg("forces"), py::arg("interactions"), py::arg("keep"),
+	          py::arg("foreign")),
 	         "Makes O.forces (forces) hold each block's force [N] and torque about its centroid [N m], gravity "
-	         "excluded.")
-	    .def("writeInteractions", &YadeSync::writeInteractions,
-	         (py::arg("scene"), py::arg("interactions"), py::arg("keep"), py::arg("foreign")),
-	         "Makes O.interactions hold a real interaction per body pair with a closed contact (none unless keep); "
-	         "foreign: [(id1, id2)] DDA pairs already there that it did not make. Returns the pair count.")
+	         "excluded, and O.interactions (interactions) a real interaction per body pair with a closed contact "
+	         "(none unless keep); foreign: [(id1, id2)] DDA pairs already there that it did not make. One pass over "
+	         "the contacts; returns the pair count.")
 	    .def("forgetBodies", &YadeSync::forgetBodies, "A body's state or shape object was replaced.")
 	    .def("forgetInteractions", &YadeSync::forgetInteractions, "A script cleared O.interactions.")
 	    .def("forgetInteraction", &YadeSync::forgetInteraction, (py::arg("id1"), py::arg("id2")),

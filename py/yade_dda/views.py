@@ -65,14 +65,13 @@ def update(scene, engines=None):
         return
     settings = getattr(scene, 'settings', None) or _DEFAULT_SETTINGS
     writer = scene.writer()
-    # O.forces: YADE resets it only where a ForceResetter runs (a DDA scene need not have one), so the
-    # writer adds what is missing; see YadeSync::writeForces for how it knows what is there.
-    writer.writeForces(scene.core, settings, O.forces)
     engines = O.engines if engines is None else engines
     keep = not any(_isLiveLoop(e) for e in engines)
     # The first update of a scene also erases DDA interactions it did not make (a loaded scene's).
     foreign = [] if scene.viewsStarted else sorted(_ddaPairs(scene))
-    writer.writeInteractions(scene.core, O.interactions, keep, foreign)
+    # O.forces: YADE resets it only where a ForceResetter runs (a DDA scene need not have one), so the
+    # writer adds what is missing; see YadeSync::writeForces for how it knows what is there.
+    writer.writeViews(scene.core, settings, O.forces, O.interactions, keep, foreign)
     scene.viewsStarted = True
     if O.trackEnergy:
         _writeEnergy(scene)
