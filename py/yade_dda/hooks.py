@@ -23,6 +23,13 @@ def _original(cls, name):
     return getattr(method, '_yadeDDA', method)
 
 
+def _wrapping(function, original):
+    """`function` (a wrapper of YADE's `original` method) with its doc, and `original` kept as its ``_yadeDDA``."""
+    function.__doc__ = original.__doc__
+    function._yadeDDA = original
+    return function
+
+
 # ------------------------------------------------------------------ BodyContainer
 
 def _wrapErase(original):
@@ -37,9 +44,7 @@ def _wrapErase(original):
                     '(O.reset()).' % (id, index))
             scene.pending = [(body, spec) for body, spec in scene.pending if body.id != id]
         return original(self, id, *args, **kw)
-    erase.__doc__ = original.__doc__
-    erase._yadeDDA = original
-    return erase
+    return _wrapping(erase, original)
 
 
 def _wrapClear(original):
@@ -47,9 +52,7 @@ def _wrapClear(original):
         result = original(self, *args, **kw)
         _scene.freshScene()
         return result
-    clear.__doc__ = original.__doc__
-    clear._yadeDDA = original
-    return clear
+    return _wrapping(clear, original)
 
 
 def _wrapReplace(original):
@@ -59,9 +62,7 @@ def _wrapReplace(original):
         result = original(self, bodies, *args, **kw)
         _scene.freshScene(bodies)
         return result
-    replace.__doc__ = original.__doc__
-    replace._yadeDDA = original
-    return replace
+    return _wrapping(replace, original)
 
 
 class _WrappedProperty(property):
@@ -96,9 +97,7 @@ def _wrapInteractionErase(original):
         if writer is not None:
             writer.forgetInteraction(id1, id2)
         return result
-    erase.__doc__ = original.__doc__
-    erase._yadeDDA = original
-    return erase
+    return _wrapping(erase, original)
 
 
 def _wrapInteractionClear(original):
@@ -108,9 +107,7 @@ def _wrapInteractionClear(original):
         if writer is not None:
             writer.forgetInteractions()
         return result
-    clear.__doc__ = original.__doc__
-    clear._yadeDDA = original
-    return clear
+    return _wrapping(clear, original)
 
 
 # ------------------------------------------------------------------ Omega
