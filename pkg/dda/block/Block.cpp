@@ -24,4 +24,16 @@ void validateMaterial(const Material& material) {
 	throw InputError(message.str());
 }
 
+int bodyIndex(const std::vector<Block>& blocks, int index) {
+	const int body = blocks[index].body;
+	return body < 0 ? index : body;
+}
+
+Vector3 interiorPoint(const Block& block) {
+	if (!block.isPart()) return block.centroid;
+	Vector3 sum = Vector3::Zero();
+	for (const Vector3& x : block.vertices) sum += x;
+	return sum / static_cast<double>(block.vertices.size());
+}
+
 }  // namespace dda

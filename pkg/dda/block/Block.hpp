@@ -31,6 +31,15 @@ struct Material {
 // Throws InputError naming the offending value.
 void validateMaterial(const Material& material);
 
+struct Block;
+// The index of the block whose unknowns block `index` moves with: its body
+// when it is a later part of a concave block (Block::body), else itself.
+int bodyIndex(const std::vector<Block>& blocks, int index);
+// A point strictly inside the block's own convex shape [m]: its centroid, or
+// for a part of a concave block (whose centroid field is the whole block's
+// when it is the body) the mean of its corners.
+Vector3 interiorPoint(const Block& block);
+
 // A penalty spring pulling a material point of the block back to its anchor.
 struct FixedPoint {
 	Vector3 position;  // current position of the material point [m]
@@ -81,6 +90,21 @@ struct Block {
 	double referenceVolume() const { return mass / material.density; }
 	// Characteristic length: cube root of the volume at creation [m].
 	double size = 0;
+
+	// Concave blocks (World::addConcaveBlock; Wu et al. 2014, Section 4): a
+	// concave block is a run of Blocks, one per convex part, at consecutive
+	// indices. The first, its body, carries the block: its unknowns, velocity,
+	// stress, strain, loads, fixed points, and the mass properties of the
+	// whole block (volume, centroid, second moments, mass, size); its own
+	// part's geometry (shape, vertices) is what the contact search sees of it.
+	// The others carry only their part's geometry (and its own volume, centroid
+	// and second moments) and move by the body's displacement function; their
+	// mass, velocity, stress and strain stay zero, so a sum over all blocks
+	// (the energy account) counts the block once. Parts never contact each
+	// other; faces two parts share are internal (BlockGeometry::internalFaces).
+	int body = -1;      // a part after the first: the index of its body; else -1
+	int partCount = 1;  // the body of a concave block: its number of parts (itself included); else 1
+	bool isPart() const { return body >= 0 || partCount > 1; }
 };
 
 }  // namespace dda

@@ -98,6 +98,8 @@ Contact& ContactStore::add(const ContactKey& key, ContactType pairType, const Su
 	(void)shapeI;
 	Contact& contact = current_.emplace_back();
 	contact.key = key;
+	contact.bodyI = key.blockI;  // ContactDetection::storePair sets the bodies of concave blocks' parts
+	contact.bodyJ = key.blockJ;
 	contact.pairType = pairType;
 	contact.geometry = geometry;
 	if (previous_.empty()) return contact;

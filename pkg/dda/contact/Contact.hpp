@@ -65,6 +65,10 @@ struct ContactHistory {
 
 struct Contact {
 	ContactKey key;
+	// The blocks whose unknowns the sub-contact joins: the key's blocks, or
+	// for a part of a concave block its body (Block::body). The key keeps the
+	// parts: their features and the contact's history belong to them.
+	int bodyI = -1, bodyJ = -1;
 	ContactType pairType = ContactType::VertexFace;  // structural type of its pair
 	SubContact geometry;      // at the start of the step
 	ContactHistory history;   // state at the end of the last accepted step

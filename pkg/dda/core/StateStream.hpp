@@ -26,7 +26,7 @@ namespace dda {
 
 // Format version of the saved state. Bump it whenever what is written, or the
 // meaning of a written value, changes; older states are then refused by name.
-inline constexpr std::uint32_t kStateVersion = 4;  // 2: a block's rigid flag; 3: MSC frames, no shell boxes; 4: the energy account
+inline constexpr std::uint32_t kStateVersion = 5;  // 2: a block's rigid flag; 3: MSC frames, no shell boxes; 4: the energy account; 5: concave blocks' parts
 
 class StateWriter {
 public:

@@ -121,6 +121,10 @@ Vector12 solveBlock(const Block& block, const BlockSystem& system) {
 }
 
 double largestVertexDisplacement(const Block& block, const Vector12& D) {
+	return largestVertexDisplacement(block.vertices, block.centroid, D);
+}
+
+double largestVertexDisplacement(const std::vector<Vector3>& vertices, const Vector3& centroid, const Vector12& D) {
 	// A non-finite solution is an unbounded displacement: +inf, never NaN,
 	// which std::max and OpenMP's max reduction would silently drop (a NaN
 	// solution then passed the step's finiteness check as 0 and wrote NaN
@@ -128,8 +132,8 @@ double largestVertexDisplacement(const Block& block, const Vector12& D) {
 	constexpr double unbounded = std::numeric_limits<double>::infinity();
 	if (!D.allFinite()) return unbounded;
 	double largest = 0;
-	for (const Vector3& x : block.vertices) {
-		const double d = displacementAt(x - block.centroid, D).squaredNorm();
+	for (const Vector3& x : vertices) {
+		const double d = displacementAt(x - centroid, D).squaredNorm();
 		if (std::isnan(d)) return unbounded;
 		largest = std::max(largest, d);
 	}
@@ -144,6 +148,18 @@ BlockMotion blockMotion(const Block& block, const Vector12& D) {
 	motion.oldCentroid = block.centroid;
 	motion.newCentroid = block.centroid + D.head<3>();
 	return motion;
+}
+
+void movePart(Block& part, const Block& body, const BlockMotion& move, const Vector12& D) {
+	for (Vector3& x : part.vertices) x = move(x);
+	part.centroid = move(part.centroid);
+	part.rotation = body.rotation;
+	// As applyStep moves the body's mass properties (a rigid block: R J R^T,
+	// the volume kept).
+	const double jacobian = body.rigid ? 1.0 : move.deformation.determinant();
+	part.volume *= jacobian;
+	part.secondMoment = jacobian * move.deformation * part.secondMoment * move.deformation.transpose();
+	if (!body.rigid) part.unsyncedStrain += D.segment<6>(6).norm();
 }
 
 Vector12 transportedRates(const Vector12& velocity, const Matrix3& rotation, const Matrix3& stretch) {

@@ -106,6 +106,9 @@ Vector12 solveBlock(const Block& block, const BlockSystem& system);
 // Largest displacement of a vertex for the unknowns D [m]; +inf when D or a
 // displacement is not finite.
 double largestVertexDisplacement(const Block& block, const Vector12& D);
+// The same for vertices of a block whose centroid is `centroid` (the other
+// parts of a concave block, Block::body) [m].
+double largestVertexDisplacement(const std::vector<Vector3>& vertices, const Vector3& centroid, const Vector12& D);
 
 // The volume ratio det(I + S) a step's strain increment S gives a deformable
 // block (1 for a rigid block) [-]. The step maps the block by R (I + S).
@@ -131,6 +134,12 @@ BlockMotion blockMotion(const Block& block, const Vector12& D);
 // turned (R J R^T), stress, strain and strain rates left exactly zero.
 // `velocity` is the end velocity (endVelocity) in the start configuration.
 void applyStep(Block& block, const Vector12& D, const Vector12& velocity);
+
+// A later part of a concave block (Block::body) over its body's accepted
+// step: its corners and centroid by the body's motion `move` (taken before
+// applyStep moved the body), its own volume and second moments as applyStep
+// moves the body's, its rotation the body's new one (call after applyStep).
+void movePart(Block& part, const Block& body, const BlockMotion& move, const Vector12& D);
 
 // A deformable block's rates (velocity: translation, spin, strain rates in the
 // step's start frame) carried through the step's stretch U = I + S and

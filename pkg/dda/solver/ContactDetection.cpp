@@ -114,12 +114,27 @@ void ContactDetection::findPairs(const std::vector<Block>& blocks, Collider& col
 	stats.cpuBroadPhase = processCpuSeconds() - cpu;
 }
 
-// Fixed blocks never move, so this runs only when blocks are added.
+// Fixed blocks never move, and the parts of a concave block move by one
+// affine map (the faces they share stay shared), so this runs only when
+// blocks are added.
 void ContactDetection::updateInternalFaces(const std::vector<Block>& blocks) {
 	std::vector<PlacedPolyhedron> fixed(blocks.size());
 	for (std::size_t b = 0; b < blocks.size(); ++b)
 		if (blocks[b].fixed) fixed[b] = PlacedPolyhedron{blocks[b].shape.get(), &blocks[b].vertices};
 	markInternalFaces(fixed, kDefaultRelativeLengthTolerance, kDefaultParallelAngleTolerance, internalFaces_);
+	// The faces the parts of a moving concave block share (a fixed one's are
+	// marked above with every fixed block).
+	std::vector<std::vector<char>> partFaces;
+	for (std::size_t b = 0; b < blocks.size(); ++b) {
+		if (blocks[b].fixed || blocks[b].partCount == 1 || blocks[b].body >= 0) continue;
+		std::vector<PlacedPolyhedron> parts;
+		for (int p = 0; p < blocks[b].partCount; ++p)
+			parts.push_back(PlacedPolyhedron{blocks[b + p].shape.get(), &blocks[b + p].vertices});
+		markInternalFaces(parts, kDefaultRelativeLengthTolerance, kDefaultParallelAngleTolerance, partFaces);
+		for (int p = 0; p < blocks[b].partCount; ++p)
+			if (std::find(partFaces[p].begin(), partFaces[p].end(), 1) != partFaces[p].end())
+				internalFaces_[b + p] = std::move(partFaces[p]);
+	}
 	internalFacesBlocks_ = static_cast<int>(blocks.size());
 }
 
@@ -201,14 +216,19 @@ void ContactDetection::detectChunk(Step& step, int begin, int count, int chunk) 
 			const auto [a, b] = pairs_[begin + q];
 			const Block& A = blocks[a];
 			const Block& B = blocks[b];
+			pairWork_[q] = NarrowPhaseWork{};
+			// Two parts of one concave block never touch (Block::body).
+			if ((A.isPart() || B.isPart()) && bodyIndex(blocks, a) == bodyIndex(blocks, b)) {
+				pairFound_[q] = 0;
+				continue;
+			}
 			const DetectionSettings detection =
 			    pairDetectionSettings(diagonals_[a], diagonals_[b], stats.contactDistance, stats.allowedDisplacement);
 			const std::vector<char>* internalA = internalFaces_[a].empty() ? nullptr : &internalFaces_[a];
 			const std::vector<char>* internalB = internalFaces_[b].empty() ? nullptr : &internalFaces_[b];
-			pairWork_[q] = NarrowPhaseWork{};
 			pairFound_[q] = detectPairContacts(
-			    BlockGeometry{A.shape.get(), &A.vertices, A.centroid, internalA, &planes_[planeSlot_[a]]},
-			    BlockGeometry{B.shape.get(), &B.vertices, B.centroid, internalB, &planes_[planeSlot_[b]]},
+			    BlockGeometry{A.shape.get(), &A.vertices, interiorPoint(A), internalA, &planes_[planeSlot_[a]]},
+			    BlockGeometry{B.shape.get(), &B.vertices, interiorPoint(B), internalB, &planes_[planeSlot_[b]]},
 			    detection, pairResults_[q], step.store.previousEntrance(a, b), step.collider.linked(begin + q),
 			    &pairWork_[q]);
 			if (pairFound_[q]) pairArea_[q] = contactArea(pairResults_[q]);
@@ -250,7 +270,7 @@ void ContactDetection::prepareContacts(Step& step, int first) {
 #pragma omp parallel for schedule(dynamic, 64) reduction(+ : friction) if (step.threads && last - first >= 256)
 	for (int k = first; k < last; ++k) {
 		Contact& contact = contacts[k];
-		prepareContact(contact, step.blocks[contact.key.blockI], step.blocks[contact.key.blockJ], step.settings);
+		prepareContact(contact, step.blocks[contact.bodyI], step.blocks[contact.bodyJ], step.settings);
 		contact.frictionTangent *= step.frictionScale;
 		friction += contact.frictionTangent > 0;
 	}
@@ -263,7 +283,10 @@ void ContactDetection::storePair(Step& step, int a, int b, const PairContacts& p
 	for (const SubContact& sub : pair.contacts) {
 		const int i = sub.firstIsA ? a : b, j = sub.firstIsA ? b : a;
 		const ContactKey key{i, j, sub.kind, sub.feature1, sub.feature2};
-		step.store.add(key, pair.type, sub, *step.blocks[i].shape, *step.blocks[j].shape).area = area;
+		Contact& contact = step.store.add(key, pair.type, sub, *step.blocks[i].shape, *step.blocks[j].shape);
+		contact.area = area;
+		contact.bodyI = bodyIndex(step.blocks, i);
+		contact.bodyJ = bodyIndex(step.blocks, j);
 	}
 }
 

@@ -65,7 +65,7 @@ void World::accountStep(const IntegratorSettings& settings) {
 	// accepted states against what the last step ended with.
 	double start = 0, end = 0;
 	for (const Contact& contact : store_.contacts()) {
-		const int bi = contact.key.blockI, bj = contact.key.blockJ;
+		const int bi = contact.bodyI, bj = contact.bodyJ;
 		const ContactStepEnergy e = contactStepEnergy(contact, blocks_[bi], blocks_[bj], openClose_.solutionOf(bi),
 		                                              openClose_.solutionOf(bj));
 		start += e.start;

@@ -42,17 +42,20 @@ std::vector<InitialOverlap> findInitialOverlaps(const std::vector<const Block*>&
 			if (boxes[b].min().x() > boxes[a].max().x()) break;
 			if (a > b) std::swap(a, b);
 			if (b < firstNew || (blocks[a]->fixed && blocks[b]->fixed) || !boxes[a].intersects(boxes[b])) continue;
+			// Parts of one concave block (Block::body; the list is the world's blocks first, in order).
+			const int bodyA = blocks[a]->body < 0 ? a : blocks[a]->body, bodyB = blocks[b]->body < 0 ? b : blocks[b]->body;
+			if (bodyA == bodyB) continue;
 			const Block& A = *blocks[a];
 			const Block& B = *blocks[b];
 			DetectionSettings detection;
 			detection.contactDistance = 0;
 			detection.lengthTolerance =
 			    kDefaultRelativeLengthTolerance * std::max(boxes[a].diagonal().norm(), boxes[b].diagonal().norm());
-			const auto pair = detectPairContacts(BlockGeometry{A.shape.get(), &A.vertices, A.centroid},
-			                                     BlockGeometry{B.shape.get(), &B.vertices, B.centroid}, detection);
+			const auto pair = detectPairContacts(BlockGeometry{A.shape.get(), &A.vertices, interiorPoint(A)},
+			                                     BlockGeometry{B.shape.get(), &B.vertices, interiorPoint(B)}, detection);
 			if (!pair || pair->separation >= 0) continue;
-			const double kn =
-			    settings.contactPenaltyFactor * std::min(A.material.young * A.size, B.material.young * B.size);
+			const double kn = settings.contactPenaltyFactor * std::min(A.material.young * blocks[bodyA]->size,
+			                                                           B.material.young * blocks[bodyB]->size);
 			const double tolerance =
 			    std::min(d0, std::max(2 * weight / kn, kInitialOverlapRelative * std::max(A.size, B.size)));
 			if (-pair->separation > tolerance) found.push_back({a, b, -pair->separation, tolerance});

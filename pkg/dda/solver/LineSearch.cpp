@@ -66,7 +66,7 @@ void OpenCloseIteration::markSearchedGroups(const Attempt& attempt) {
 	lineGroup_.clear();
 	for (std::size_t c = 0; c < contacts.size(); ++c) {
 		const Contact& contact = contacts[c];
-		const int bi = contact.key.blockI, bj = contact.key.blockJ;
+		const int bi = contact.bodyI, bj = contact.bodyJ;
 		const int group = contactGroup_[c];
 		// A slipping contact's force is not quadratic, so a group with one is
 		// always searched. Opening and closing are searched once a contact of

@@ -30,14 +30,22 @@ void OpenCloseIteration::selectMovingBlocks(const std::vector<Block>& blocks, co
 	const int count = static_cast<int>(blocks.size());
 	moving_.clear();
 	movingIndex_.assign(count, -1);
+	int bodies = 0;
 	for (int i = 0; i < count; ++i) {
+		// A concave block's later parts move with its body (Block::body):
+		// their contacts take its unknowns.
+		if (blocks[i].body >= 0) {
+			movingIndex_[i] = movingIndex_[blocks[i].body];
+			continue;
+		}
+		++bodies;
 		if (blocks[i].fixed || (!frozen.empty() && frozen[i])) continue;
 		movingIndex_[i] = static_cast<int>(moving_.size());
 		moving_.push_back(i);
 	}
 	const int n = static_cast<int>(moving_.size());
 	stats.movingBlocks = n;
-	stats.fixedBlocks = count - n;
+	stats.fixedBlocks = bodies - n;
 	blockUnknowns_.resize(n);
 	for (int k = 0; k < n; ++k) {
 		const Block& b = blocks[moving_[k]];
@@ -113,14 +121,14 @@ void OpenCloseIteration::startAttempt(const Attempt& attempt, bool firstStep) {
 	keptTermsOf_.assign(contacts.size(), -1);
 	for (Contact& contact : contacts) {
 		startTrial(contact, firstStep);
-		const Block& blockI = attempt.blocks[contact.key.blockI];
-		const Block& blockJ = attempt.blocks[contact.key.blockJ];
+		const Block& blockI = attempt.blocks[contact.bodyI];
+		const Block& blockJ = attempt.blocks[contact.bodyJ];
 		// The first pass's limit from the normal force at the start of
 		// the step (its gap now), not the one the contact ended the last
 		// step with: a corner that bounced off keeps no friction.
-		evaluateContact(contact, blockI, blockJ, solutionOf(contact.key.blockI), solutionOf(contact.key.blockJ));
+		evaluateContact(contact, blockI, blockJ, solutionOf(contact.bodyI), solutionOf(contact.bodyJ));
 		updateFrictionLimit(contact, true);
-		evaluateContact(contact, blockI, blockJ, solutionOf(contact.key.blockI), solutionOf(contact.key.blockJ));
+		evaluateContact(contact, blockI, blockJ, solutionOf(contact.bodyI), solutionOf(contact.bodyJ));
 	}
 	computeStartAccelerations(attempt);
 	// The blocks that contacts join (open ones too: their energy counts
@@ -159,7 +167,7 @@ bool OpenCloseIteration::evaluateStates(const Attempt& attempt) {
 		Contact& contact = contacts[c];
 		const int g = contactGroup_[c];
 		if (group_.done[g]) continue;
-		const int bi = contact.key.blockI, bj = contact.key.blockJ;
+		const int bi = contact.bodyI, bj = contact.bodyJ;
 		const Block& blockI = attempt.blocks[bi];
 		const Block& blockJ = attempt.blocks[bj];
 		const Vector12& Di = solutionOf(bi);
@@ -261,7 +269,7 @@ bool OpenCloseIteration::startPasses(const Attempt& attempt) {
 		const bool hadTerms = isClosed(contact) || contact.slipLimit > 0;
 		updateFrictionLimit(contact, true);
 		if (hadTerms != (isClosed(contact) || contact.slipLimit > 0)) structureStale = true;
-		const int bi = contact.key.blockI, bj = contact.key.blockJ;
+		const int bi = contact.bodyI, bj = contact.bodyJ;
 		evaluateContact(contact, attempt.blocks[bi], attempt.blocks[bj], solutionOf(bi), solutionOf(bj));
 	}
 	return structureStale;
@@ -277,7 +285,7 @@ void OpenCloseIteration::groupContacts(const std::vector<Contact>& contacts) {
 		return k;
 	};
 	for (const Contact& contact : contacts) {
-		const int mi = movingIndex_[contact.key.blockI], mj = movingIndex_[contact.key.blockJ];
+		const int mi = movingIndex_[contact.bodyI], mj = movingIndex_[contact.bodyJ];
 		if (mi < 0 || mj < 0) continue;
 		const int a = find(mi), b = find(mj);
 		if (a != b) root[std::max(a, b)] = std::min(a, b);
@@ -285,8 +293,8 @@ void OpenCloseIteration::groupContacts(const std::vector<Contact>& contacts) {
 	for (int k = 0; k < n; ++k) root[k] = find(k);
 	contactGroup_.resize(contacts.size());
 	for (std::size_t c = 0; c < contacts.size(); ++c) {
-		const int mi = movingIndex_[contacts[c].key.blockI];
-		contactGroup_[c] = root[mi >= 0 ? mi : movingIndex_[contacts[c].key.blockJ]];
+		const int mi = movingIndex_[contacts[c].bodyI];
+		contactGroup_[c] = root[mi >= 0 ? mi : movingIndex_[contacts[c].bodyJ]];
 	}
 }
 
@@ -344,7 +352,13 @@ double OpenCloseIteration::largestDisplacement(const std::vector<Block>& blocks)
 	const int n = static_cast<int>(moving_.size());
 	double largest = 0;
 #pragma omp parallel for schedule(static) reduction(max : largest) if (n >= kMinBlocksForThreads)
-	for (int k = 0; k < n; ++k) largest = std::max(largest, largestVertexDisplacement(blocks[moving_[k]], solutions_[k]));
+	for (int k = 0; k < n; ++k) {
+		const Block& body = blocks[moving_[k]];
+		largest = std::max(largest, largestVertexDisplacement(body, solutions_[k]));
+		for (int p = 1; p < body.partCount; ++p)  // a concave block's other parts, about its centroid
+			largest = std::max(largest, largestVertexDisplacement(blocks[moving_[k] + p].vertices, body.centroid,
+			                                                      solutions_[k]));
+	}
 	return largest;
 }
 

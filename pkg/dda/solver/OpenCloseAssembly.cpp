@@ -26,7 +26,7 @@ void OpenCloseIteration::buildSystemStructure(const Attempt& attempt) {
 	for (const Contact& contact : attempt.contacts) {
 		// No terms (open, and no tangential spring): couples nothing.
 		if (!hasNormalTerms(contact) && tangentialTerm(contact) == TangentialTerm::None) continue;
-		const int mi = movingIndex_[contact.key.blockI], mj = movingIndex_[contact.key.blockJ];
+		const int mi = movingIndex_[contact.bodyI], mj = movingIndex_[contact.bodyJ];
 		if (mi >= 0) hasSprings_[mi] = 1;
 		if (mj >= 0) hasSprings_[mj] = 1;
 		if (mi >= 0 && mj >= 0) links_.emplace_back(mi, mj);
@@ -87,7 +87,7 @@ void OpenCloseIteration::assembleContacts(const Attempt& attempt) {
 	keptTermsKey_.resize(contacts.size(), 0);
 	for (std::size_t c = 0; c < contacts.size(); ++c) {
 		const Contact& contact = contacts[c];
-		const int bi = contact.key.blockI, bj = contact.key.blockJ;
+		const int bi = contact.bodyI, bj = contact.bodyJ;
 		const bool normalTerms = hasNormalTerms(contact);
 		const TangentialTerm tangential = tangentialTerm(contact);
 		// No terms (what contactTerms returns false for).

@@ -54,7 +54,7 @@ void World::markSettlingBlocks() {
 	};
 	for (const Contact& contact : store_.contacts()) {
 		if (!contact.normal.valid || contact.normal.d0 > 0) continue;
-		const int a = find(contact.key.blockI), b = find(contact.key.blockJ);
+		const int a = find(contact.bodyI), b = find(contact.bodyJ);
 		if (a != b) root[std::max(a, b)] = std::min(a, b);
 	}
 	std::vector<char> supported(count, 0), moving(count, 0);
@@ -145,8 +145,8 @@ void World::dropFrozenContacts(StepStatistics& stats) {
 	std::vector<Contact>& found = store_.contacts();
 	found.erase(std::remove_if(found.begin(), found.end(),
 	                           [&](const Contact& c) {
-		                           return openClose_.movingIndex(c.key.blockI) < 0 &&
-		                                  openClose_.movingIndex(c.key.blockJ) < 0;
+		                           return openClose_.movingIndex(c.bodyI) < 0 &&
+		                                  openClose_.movingIndex(c.bodyJ) < 0;
 	                           }),
 	            found.end());
 	stats.contacts = static_cast<int>(found.size());

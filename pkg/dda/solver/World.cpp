@@ -6,6 +6,7 @@
 
 #include "ContactEquations.hpp"
 #include "StepClock.hpp"
+#include "dda/geometry/ConvexParts.hpp"
 #include "dda/geometry/MassProperties.hpp"
 #include "dda/core/CapacityBytes.hpp"
 
@@ -32,6 +33,56 @@ int World::addBlock(const std::vector<Vector3>& points, const Material& material
 	block.shape = topologies_.intern(std::move(block.shape));
 	blocks_.push_back(std::move(block));
 	return blockCount() - 1;
+}
+
+int World::addConcaveBlock(const std::vector<std::vector<Vector3>>& parts, const Material& material, bool fixed,
+                           bool rigid) {
+	std::vector<Block> made = makeConcaveBlock(parts, material, fixed, rigid);
+	const int first = blockCount();
+	reserveBlocks(static_cast<int>(made.size()));
+	for (Block& block : made) {
+		block.shape = topologies_.intern(std::move(block.shape));
+		if (block.body >= 0) block.body += first;
+		blocks_.push_back(std::move(block));
+	}
+	return first;
+}
+
+std::vector<Block> makeConcaveBlock(const std::vector<std::vector<Vector3>>& parts, const Material& material,
+                                    bool fixed, bool rigid) {
+	validateMaterial(material);
+	if (parts.empty()) throw InputError("a concave block needs at least one part");
+	std::vector<ConvexPolyhedron> polyhedra;
+	std::vector<Block> blocks;
+	std::vector<MassProperties> properties;
+	for (std::size_t p = 0; p < parts.size(); ++p) {
+		try {
+			polyhedra.push_back(buildConvexPolyhedron(parts[p]));
+			blocks.push_back(makeBlock(parts[p], material, fixed, rigid));
+		} catch (const InputError& error) {
+			throw InputError("part " + std::to_string(p) + " of the concave block: " + error.what());
+		}
+		const Block& b = blocks.back();
+		properties.push_back(MassProperties{b.volume, b.centroid, b.secondMoment});
+	}
+	checkConvexParts(polyhedra);
+	if (blocks.size() == 1) return blocks;
+	// The body carries the whole block's mass properties; each later part
+	// its own volume, centroid and second moments (moved with it), no mass.
+	const MassProperties whole = unionMassProperties(properties);
+	Block& body = blocks.front();
+	body.centroid = whole.centroid;
+	body.volume = whole.volume;
+	body.secondMoment = whole.secondMoment;
+	body.mass = material.density * whole.volume;
+	body.size = std::cbrt(whole.volume);
+	body.partCount = static_cast<int>(blocks.size());
+	for (std::size_t p = 1; p < blocks.size(); ++p) {
+		blocks[p].body = 0;
+		blocks[p].mass = 0;
+		blocks[p].size = body.size;
+	}
+	return blocks;
 }
 
 void World::reserveBlocks(int extra) {
@@ -68,10 +119,15 @@ Block& World::block(int index) {
 }
 const Block& World::block(int index) const { return const_cast<World*>(this)->block(index); }
 
+Block& World::bodyBlock(int index) {
+	block(index);  // checks the index
+	return blocks_[bodyOf(index)];
+}
+
 void World::addFixedPoint(int index, const Vector3& position, double stiffness) {
 	requireFinite(position, "a fixed point");
 	if (!std::isfinite(stiffness)) throw InputError("fixed point stiffness must be finite");
-	Block& b = block(index);
+	Block& b = bodyBlock(index);
 	if (b.fixed) throw InputError("block " + std::to_string(index) + " is fixed: a fixed point would have no effect");
 	b.fixedPoints.push_back({position, position, stiffness});
 }
@@ -79,7 +135,7 @@ void World::addFixedPoint(int index, const Vector3& position, double stiffness) 
 void World::addPointLoad(int index, const Vector3& position, const Vector3& force) {
 	requireFinite(position, "a point load's position");
 	requireFinite(force, "a point load's force");
-	Block& b = block(index);
+	Block& b = bodyBlock(index);
 	if (b.fixed) throw InputError("block " + std::to_string(index) + " is fixed: a point load would have no effect");
 	b.loads.push_back({position, force});
 }
@@ -87,7 +143,7 @@ void World::addPointLoad(int index, const Vector3& position, const Vector3& forc
 void World::setVelocity(int index, const Vector3& velocity, const Vector3& angularVelocity) {
 	requireFinite(velocity, "velocity");
 	requireFinite(angularVelocity, "angular velocity");
-	Block& b = block(index);
+	Block& b = bodyBlock(index);
 	if (b.fixed && !(velocity.isZero() && angularVelocity.isZero()))
 		throw InputError("a fixed block cannot be given a velocity");
 	b.velocity.head<3>() = velocity;
@@ -96,7 +152,7 @@ void World::setVelocity(int index, const Vector3& velocity, const Vector3& angul
 
 void World::setStress(int index, const Vector6& stress) {
 	if (!stress.allFinite()) throw InputError("initial stress must be finite");
-	Block& b = block(index);
+	Block& b = bodyBlock(index);
 	if (b.rigid && !stress.isZero()) {
 		std::ostringstream message;
 		message << "block " << index << " is rigid: it has no strain and carries no stress, so it cannot be given an "
@@ -236,7 +292,7 @@ void World::moveContactsAndBlocks(const IntegratorSettings& settings, double dt,
 #pragma omp for schedule(static)
 		for (int c = 0; c < contactCount; ++c) {
 			Contact& contact = contacts[c];
-			const int bi = contact.key.blockI, bj = contact.key.blockJ;
+			const int bi = contact.bodyI, bj = contact.bodyJ;
 			const int mi = openClose_.movingIndex(bi), mj = openClose_.movingIndex(bj);
 			const Vector12& Di = openClose_.solutionOf(bi);
 			const Vector12& Dj = openClose_.solutionOf(bj);
@@ -270,6 +326,8 @@ void World::moveContactsAndBlocks(const IntegratorSettings& settings, double dt,
 		Block& block = blocks_[moving[k]];
 		applyStep(block, openClose_.solution(k),
 		          endVelocity(openClose_.solution(k), startVelocity(block, settings), dt));
+		for (int p = 1; p < block.partCount; ++p)
+			movePart(blocks_[moving[k] + p], block, motions_[k], openClose_.solution(k));
 	}
 	stats.timeUpdate = secondsSince(phase);
 }

@@ -26,6 +26,16 @@ class StateReader;
 // (throws InputError naming the problem). World::addBlock adds one.
 Block makeBlock(const std::vector<Vector3>& points, const Material& material, bool fixed, bool rigid = false);
 
+// The blocks of a concave block made of convex parts, each given by its
+// corners [m] (Block::body: the first is its body, the others refer to it by
+// an index relative to the first, which World::addConcaveBlock offsets).
+// Throws InputError naming the part and the problem: a part that is no
+// convex polyhedron (buildConvexPolyhedron), parts that overlap, share a face
+// only in part, or are not one piece (checkConvexParts). One part makes an
+// ordinary convex block.
+std::vector<Block> makeConcaveBlock(const std::vector<std::vector<Vector3>>& parts, const Material& material,
+                                    bool fixed, bool rigid = false);
+
 // boundingDiagonal and pairDetectionSettings: ContactDetection.hpp.
 
 class World {
@@ -33,6 +43,14 @@ public:
 	// Builds and validates a block (throws InputError; the world is unchanged then).
 	// A rigid block has 6 unknowns (translation, rotation) and no strain or stress.
 	int addBlock(const std::vector<Vector3>& points, const Material& material, bool fixed, bool rigid = false);
+	// A concave block (makeConcaveBlock): its parts join the world as
+	// consecutive blocks; returns the index of the first, its body, which
+	// carries its unknowns, mass properties and state (Block::body).
+	int addConcaveBlock(const std::vector<std::vector<Vector3>>& parts, const Material& material, bool fixed,
+	                    bool rigid = false);
+	// The body a block moves with (bodyIndex; itself unless it is a later
+	// part of a concave block).
+	int bodyOf(int index) const { return bodyIndex(blocks_, index); }
 	// Room for `extra` more blocks before they are added one by one: the
 	// block array then holds what the scene needs instead of up to twice that
 	// (push_back's doubling: 65,536 blocks of storage for 50,000), and is not
@@ -101,6 +119,9 @@ public:
 	void readState(StateReader& in);
 
 private:
+	// The block `index` moves with (bodyOf), after checking the index: what
+	// the setters above change (a concave block's state is its body's).
+	Block& bodyBlock(int index);
 	// One accepted step of the blocks not frozen (frozen_), as step() makes it.
 	double advance(const IntegratorSettings& settings);
 	// The attempts of a step (OpenCloseIteration::solve) at the dt that

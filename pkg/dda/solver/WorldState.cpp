@@ -86,6 +86,8 @@ void writeBlock(StateWriter& out, const Block& b) {
 	}
 	out.pod(b.unsyncedStrain);
 	out.pod(b.size);
+	out.pod(b.body);
+	out.pod(b.partCount);
 }
 
 // The block's topology is its own; World::readState interns it.
@@ -127,6 +129,8 @@ Block readBlock(StateReader& in) {
 	}
 	in.pod(b.unsyncedStrain);
 	in.pod(b.size);
+	in.pod(b.body);
+	in.pod(b.partCount);
 	return b;
 }
 
@@ -307,6 +311,15 @@ void World::readState(StateReader& in) {
 		b.shape = w.topologies_.intern(std::move(b.shape));
 	}
 	const int n = w.blockCount();
+	// Concave blocks: each body followed by its other parts, which refer to it.
+	for (int b = 0; b < n; ++b) {
+		const Block& block = w.blocks_[b];
+		if (block.body >= 0 ? block.partCount != 1 || block.body >= b || w.blocks_[block.body].partCount <= b - block.body
+		                    : block.partCount < 1 || b + block.partCount > n)
+			in.fail("block " + std::to_string(b) + " has inconsistent concave-block parts");
+		for (int p = 1; p < block.partCount; ++p)
+			if (w.blocks_[b + p].body != b) in.fail("part " + std::to_string(b + p) + " does not refer to its body");
+	}
 	const std::vector<std::vector<char>>& internalFaces = w.detection_.internalFaces();
 	if (internalFaces.size() > w.blocks_.size()) in.fail("more internal-face lists than blocks");
 	for (std::size_t b = 0; b < internalFaces.size(); ++b)
@@ -321,7 +334,11 @@ void World::readState(StateReader& in) {
 
 	in.tag("CNTS");
 	std::vector<Contact> contacts(in.size(64, "contacts"));
-	for (Contact& c : contacts) c = readContact(in, n);
+	for (Contact& c : contacts) {
+		c = readContact(in, n);
+		c.bodyI = w.bodyOf(c.key.blockI);
+		c.bodyJ = w.bodyOf(c.key.blockJ);
+	}
 	std::unordered_map<std::uint64_t, EntranceFeature> entrances;
 	const std::size_t entranceCount = in.size(8 + 3 * sizeof(int), "entrance features");
 	for (std::size_t k = 0; k < entranceCount; ++k) {

@@ -1,0 +1,37 @@
+// The convex parts of a concave block (World::addConcaveBlock; Wu et al.
+// 2014, Section 4): the check that they make one solid, and the mass
+// properties of their union. Geometry only. Units: m, m^3, m^5.
+#pragma once
+
+#include "ConvexPolyhedron.hpp"
+#include "MassProperties.hpp"
+
+#include <vector>
+
+namespace dda {
+
+// Throws InputError naming the parts when they do not make one solid:
+//   - two parts overlap: no plane separates them, i.e. along every face
+//     normal of either and every cross product of an edge of one with an edge
+//     of the other (the separating-axis theorem for convex polyhedra, which
+//     is exact with these axes) their extents overlap by more than the
+//     length tolerance (kCoplanarRelativeTolerance x the larger bounding-box
+//     diagonal); the message gives the smallest such overlap [m];
+//   - two parts share a region of a face plane with positive area (opposed,
+//     coplanar faces whose polygons overlap by more than tolerance^2) without
+//     either face lying wholly on the other: such a face would be partly
+//     inside the block and partly outside, and contacts on it could not be
+//     told apart; the parts must be split so that each shared face is a whole
+//     face of at least one of the two;
+//   - the parts are not one piece: the graph of shared faces is not connected.
+// A single part is accepted (a convex block).
+void checkConvexParts(const std::vector<ConvexPolyhedron>& parts);
+
+// The volume, centroid and second moments about the centroid of the union of
+// disjoint parts, each given with its own about its own centroid: volumes
+// add, the centroid is the volume-weighted mean, and each part's second
+// moments shift to the common centroid by V_p (c_p - c)(c_p - c)^T
+// (the parallel-axis rule; exact).
+MassProperties unionMassProperties(const std::vector<MassProperties>& parts);
+
+}  // namespace dda
