@@ -1,5 +1,7 @@
 #include "SceneLink.hpp"
 
+#include "dda/geometry/MassProperties.hpp"
+
 #include <algorithm>
 #include <limits>
 #include <sstream>
@@ -51,7 +53,7 @@ void SceneLink::link(int blockIndex, int bodyId, const Vector3& position0, const
 	double radius = 0;
 	for (std::size_t j = 0; j < n; ++j) {
 		blockLocal[j] = inverse * (b.vertices[j] - position0);
-		radius = std::max(radius, (b.vertices[j] - b.centroid).norm());
+		radius = std::max(radius, (b.vertices[j] - partPosition(blockIndex)).norm());
 	}
 	const double eps = std::numeric_limits<double>::epsilon();
 	const double tolerance = eps * (kPositionRoundoff * position0.norm() + kFrameRoundoff * radius);
@@ -118,7 +120,49 @@ BodyLink* SceneLink::bodyLink(int blockIndex) {
 
 int SceneLink::blockOfBody(int bodyId) const {
 	const auto found = blockOfBody_.find(bodyId);
-	return found == blockOfBody_.end() ? -1 : found->second;
+	return found == blockOfBody_.end() ? -1 : world.bodyOf(found->second);
+}
+
+void SceneLink::linkClump(int block, int clumpId, const Eigen::Quaterniond& orientation0) {
+	if (world.block(block).partCount < 2) {
+		std::ostringstream message;
+		message << "block " << block << " is not the body of a concave block: no clump to link";
+		throw std::invalid_argument(message.str());
+	}
+	if (blockOfBody_.count(clumpId)) {
+		std::ostringstream message;
+		message << "body " << clumpId << " is already linked to block " << blockOfBody_.at(clumpId);
+		throw std::invalid_argument(message.str());
+	}
+	clumps_[block] = ClumpLink{clumpId, orientation0.normalized(), false};
+	blockOfBody_[clumpId] = block;
+}
+
+const ClumpLink* SceneLink::clumpLink(int block) const {
+	const auto found = clumps_.find(block);
+	return found == clumps_.end() ? nullptr : &found->second;
+}
+
+ClumpLink* SceneLink::clumpLink(int block) {
+	return const_cast<ClumpLink*>(static_cast<const SceneLink*>(this)->clumpLink(block));
+}
+
+Eigen::Quaterniond SceneLink::clumpOrientation(int block) const {
+	const ClumpLink* link = clumpLink(block);
+	const Eigen::Quaterniond base = link ? link->orientation0 : Eigen::Quaterniond::Identity();
+	return (world.block(block).rotation * base).normalized();
+}
+
+Vector3 SceneLink::partPosition(int block) const {
+	const Block& b = world.block(block);
+	if (b.partCount < 2) return b.centroid;
+	return computeMassProperties(b.vertices, b.shape->faces).centroid;
+}
+
+Vector3 SceneLink::partVelocity(int block) const {
+	const Block& body = world.block(world.bodyOf(block));
+	if (!world.block(block).isPart()) return body.velocity.head<3>();
+	return displacementAt(partPosition(block) - body.centroid, body.velocity);
 }
 
 Eigen::Quaterniond SceneLink::bodyOrientation(int blockIndex) const {
@@ -133,7 +177,8 @@ std::vector<Vector3> SceneLink::localVertices(int blockIndex) const {
 	const Eigen::Quaterniond inverse = bodyOrientation(blockIndex).conjugate();
 	std::vector<Vector3> local;
 	if (!link) return local;
-	for (int j : link->vertexOrder) local.push_back(inverse * (b.vertices[j] - b.centroid));
+	const Vector3 position = partPosition(blockIndex);
+	for (int j : link->vertexOrder) local.push_back(inverse * (b.vertices[j] - position));
 	return local;
 }
 

@@ -10,6 +10,7 @@
 
 #include <Eigen/Geometry>
 
+#include <map>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -21,6 +22,16 @@ struct BodyLink {
 	Eigen::Quaterniond orientation0 = Eigen::Quaterniond::Identity();  // body ori at creation
 	std::vector<int> vertexOrder;  // body vertex k is block vertex vertexOrder[k]
 	bool synced = false;           // written at least once (fixed blocks need only that)
+};
+
+// A concave block (World::addConcaveBlock) shows in YADE as a clump: each
+// part a member body with a Polyhedra shape (linked like any block), the
+// block as a whole the clump body, whose state the sync writes (position the
+// block's centroid, orientation, velocity, angular velocity).
+struct ClumpLink {
+	int bodyId = -1;
+	Eigen::Quaterniond orientation0 = Eigen::Quaterniond::Identity();  // the clump's ori at creation
+	bool synced = false;
 };
 
 class SceneLink {
@@ -45,8 +56,23 @@ public:
 	          const std::vector<Vector3>& localVertices);
 	const BodyLink* bodyLink(int block) const;
 	BodyLink* bodyLink(int block);
+	// The clump body of a concave block, `block` its body (World::bodyOf);
+	// std::invalid_argument when it is not one, or the id is taken.
+	void linkClump(int block, int clumpId, const Eigen::Quaterniond& orientation0);
+	const ClumpLink* clumpLink(int block) const;  // nullptr unless linked
+	ClumpLink* clumpLink(int block);
+	const std::map<int, ClumpLink>& clumps() const { return clumps_; }
+	// The block a body shows: the block itself, or for a member or the clump
+	// of a concave block its body (World::bodyOf); -1 for other bodies.
 	int blockOfBody(int bodyId) const;
 	Eigen::Quaterniond bodyOrientation(int block) const;
+	Eigen::Quaterniond clumpOrientation(int block) const;
+	// Where YADE's body of a block sits [m]: the block's centroid, or for a
+	// part of a concave block the part's own (the body of a concave block
+	// holds the whole block's centroid; its own part's is computed).
+	Vector3 partPosition(int block) const;
+	// Velocity of that point [m/s] (of the block's body's motion).
+	Vector3 partVelocity(int block) const;
 	std::vector<Vector3> localVertices(int block) const;
 
 	// World::reserveBlocks, and as much room in the body links.
@@ -64,7 +90,8 @@ public:
 
 private:
 	std::vector<BodyLink> links_;  // per block; bodyId -1 until linked
-	std::unordered_map<int, int> blockOfBody_;
+	std::unordered_map<int, int> blockOfBody_;  // a member's part, a clump's body
+	std::map<int, ClumpLink> clumps_;           // by the concave block's body
 };
 
 }  // namespace dda

@@ -16,6 +16,14 @@ std::string SceneLink::saveState() const {
 		out.podVector(link.vertexOrder);
 		out.pod(static_cast<std::uint8_t>(link.synced));
 	}
+	out.tag("CLMP");
+	out.size(clumps_.size());
+	for (const auto& [block, clump] : clumps_) {
+		out.pod(block);
+		out.pod(clump.bodyId);
+		out.quaternion(clump.orientation0);
+		out.pod(static_cast<std::uint8_t>(clump.synced));
+	}
 	out.tag("END.");
 	return frameState(out.bytes());
 }
@@ -43,11 +51,26 @@ void SceneLink::loadState(const std::string& state) {
 		if (link.bodyId >= 0 && !blockOfBody.emplace(link.bodyId, static_cast<int>(b)).second)
 			in.fail("body " + std::to_string(link.bodyId) + " is linked to two blocks");
 	}
+	in.tag("CLMP");
+	std::map<int, ClumpLink> clumps;
+	const std::size_t clumpCount = in.size(4 + 4 + 32 + 1, "clump links");
+	for (std::size_t k = 0; k < clumpCount; ++k) {
+		const int block = in.pod<int>();
+		ClumpLink clump;
+		in.pod(clump.bodyId);
+		in.quaternion(clump.orientation0);
+		clump.synced = in.pod<std::uint8_t>() != 0;
+		if (block < 0 || block >= restored.blockCount() || restored.block(block).partCount < 2)
+			in.fail("a clump link of block " + std::to_string(block) + ", which is no concave block's body");
+		if (!clumps.emplace(block, clump).second || !blockOfBody.emplace(clump.bodyId, block).second)
+			in.fail("clump body " + std::to_string(clump.bodyId) + " is linked twice");
+	}
 	in.tag("END.");
 	if (!in.atEnd()) in.fail("bytes left after the end of the state");
 	world = std::move(restored);
 	links_ = std::move(links);
 	blockOfBody_ = std::move(blockOfBody);
+	clumps_ = std::move(clumps);
 }
 
 }  // namespace dda

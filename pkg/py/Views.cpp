@@ -20,7 +20,10 @@
 // A block's force is the sum of the forces on it (contacts, point loads,
 // fixed-point springs): everything but gravity and inertia, as O.forces holds
 // for YADE's bodies (NewtonIntegrator adds gravity itself). Its torque is
-// taken about its centroid.
+// taken about its centroid. A concave block shows as a YADE clump: each
+// member (part) carries its part's contacts, torque about the part's own
+// centroid, and the clump the block's loads and fixed-point springs, torque
+// about the block's centroid; YADE's unbalancedForce adds them up.
 #include "YadeSync.hpp"
 #include "dda/solver/BlockEquations.hpp"
 
@@ -44,8 +47,8 @@ struct PairSum {
 
 // The forces on block i from its closed contacts [N], their torques about
 // its centroid [N m], and (when `pairs`) the body pairs' sums, in one pass.
-void contactSums(const SceneLink& s, std::vector<Vector3>* force, std::vector<Vector3>* torque,
-                 std::map<std::pair<int, int>, PairSum>* pairs) {
+void contactSums(const SceneLink& s, const std::vector<Vector3>* position, std::vector<Vector3>* force,
+                 std::vector<Vector3>* torque, std::map<std::pair<int, int>, PairSum>* pairs) {
 	const World& w = s.world;
 	for (const Contact& c : w.contacts()) {
 		if (c.history.state == ContactState::Open) continue;
@@ -56,8 +59,8 @@ void contactSums(const SceneLink& s, std::vector<Vector3>* force, std::vector<Ve
 		const Vector3 onI = c.geometry.normal * c.history.normalForce + c.history.shearForce;
 		(*force)[i] += onI;
 		(*force)[j] -= onI;
-		(*torque)[i] += (c.point - w.block(i).centroid).cross(onI);
-		(*torque)[j] -= (c.point - w.block(j).centroid).cross(onI);
+		(*torque)[i] += (c.point - (*position)[i]).cross(onI);
+		(*torque)[j] -= (c.point - (*position)[j]).cross(onI);
 		if (!pairs) continue;
 		// Body order: id1 is the smaller body id. The normal n_k points from j
 		// to i: from id1 to id2 when i is id2.
@@ -85,9 +88,10 @@ void contactSums(const SceneLink& s, std::vector<Vector3>* force, std::vector<Ve
 ContactViews contactViews(const SceneLink& s, const IntegratorSettings& settings, bool withPairs) {
 	const World& w = s.world;
 	const int n = w.blockCount();
-	std::vector<Vector3> force(n, Vector3::Zero()), torque(n, Vector3::Zero());
+	std::vector<Vector3> force(n, Vector3::Zero()), torque(n, Vector3::Zero()), position(n);
+	for (int i = 0; i < n; ++i) position[i] = w.block(i).isPart() ? s.partPosition(i) : w.block(i).centroid;
 	std::map<std::pair<int, int>, PairSum> pairs;
-	contactSums(s, &force, &torque, withPairs ? &pairs : nullptr);
+	contactSums(s, &position, &force, &torque, withPairs ? &pairs : nullptr);
 	ContactViews out;
 	out.pairs.reserve(pairs.size());
 	for (const auto& [ids, p] : pairs) {
@@ -103,7 +107,10 @@ ContactViews contactViews(const SceneLink& s, const IntegratorSettings& settings
 		const BodyLink* link = s.bodyLink(i);
 		if (!link) continue;
 		const Block& b = w.block(i);
-		Vector3 f = force[i], m = torque[i];
+		// A concave block's loads and springs act on its clump (its members
+		// carry their parts' contacts, as YADE's clump members do).
+		const ClumpLink* clump = s.clumpLink(i);
+		Vector3 f = clump ? Vector3(Vector3::Zero()) : force[i], m = clump ? Vector3(Vector3::Zero()) : torque[i];
 		for (const PointLoad& load : b.loads) {
 			f += load.force;
 			m += (load.position - b.centroid).cross(load.force);
@@ -113,7 +120,12 @@ ContactViews contactViews(const SceneLink& s, const IntegratorSettings& settings
 			f += spring;
 			m += (point.position - b.centroid).cross(spring);
 		}
-		out.bodies.push_back(BodyForce{link->bodyId, f, m});
+		if (clump) {
+			out.bodies.push_back(BodyForce{link->bodyId, force[i], torque[i]});
+			out.bodies.push_back(BodyForce{clump->bodyId, f, m});
+		} else {
+			out.bodies.push_back(BodyForce{link->bodyId, f, m});
+		}
 	}
 	return out;
 }

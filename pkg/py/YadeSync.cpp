@@ -58,19 +58,20 @@ void YadeSync::setVector(PyObject* target, PyObject* attribute, const Vector3& v
 YadeSync::BodyObjects& YadeSync::bodyObjects(const py::object& bodies, int block, int bodyId) {
 	if (static_cast<int>(bodies_.size()) <= block) bodies_.resize(block + 1);
 	BodyObjects& kept = bodies_[block];
-	if (kept.state.is_none()) {
-		const py::object body = owned(PyObject_GetItem(bodies.ptr(), py::object(bodyId).ptr()));
-		if (body.is_none()) {
-			PyErr_Format(PyExc_RuntimeError,
-			             "body %d of a DDA block was removed from O.bodies; removing DDA blocks mid-run is not "
-			             "supported",
-			             bodyId);
-			py::throw_error_already_set();
-		}
-		kept.state = owned(PyObject_GetAttr(body.ptr(), names().state));
-		kept.shape = owned(PyObject_GetAttr(body.ptr(), names().shape));
-	}
+	if (kept.state.is_none()) kept = lookUp(bodies, bodyId);
 	return kept;
+}
+
+YadeSync::BodyObjects YadeSync::lookUp(const py::object& bodies, int bodyId) {
+	const py::object body = owned(PyObject_GetItem(bodies.ptr(), py::object(bodyId).ptr()));
+	if (body.is_none()) {
+		PyErr_Format(PyExc_RuntimeError,
+		             "body %d of a DDA block was removed from O.bodies; removing DDA blocks mid-run is not supported",
+		             bodyId);
+		py::throw_error_already_set();
+	}
+	return BodyObjects{owned(PyObject_GetAttr(body.ptr(), names().state)),
+	                   owned(PyObject_GetAttr(body.ptr(), names().shape))};
 }
 
 const YadeSync::VertexList& YadeSync::vertexList(std::size_t count) {
@@ -98,11 +99,13 @@ int YadeSync::writeBodies(SceneLink& s, const py::object& bodies, bool all) {
 		if (!link || (b.fixed && !first && !all)) continue;
 		BodyObjects& body = bodyObjects(bodies, i, link->bodyId);
 		PyObject* state = body.state.ptr();
-		setVector(state, n.pos, b.centroid);
+		// A part of a concave block: its own centroid, moving with its body.
+		const Block& moving = b.isPart() ? s.world.block(s.world.bodyOf(i)) : b;
+		setVector(state, n.pos, b.isPart() ? s.partPosition(i) : b.centroid);
 		*quaternionValue_ = s.bodyOrientation(i);
 		check(PyObject_SetAttr(state, n.ori, quaternion_.ptr()));
-		setVector(state, n.vel, b.velocity.head<3>());
-		setVector(state, n.angVel, b.velocity.segment<3>(3));
+		setVector(state, n.vel, b.isPart() ? s.partVelocity(i) : b.velocity.head<3>());
+		setVector(state, n.angVel, moving.velocity.segment<3>(3));
 		// Vertices in the body's local frame and vertex order: at the first
 		// write (YADE's frame is at YADE's centroid, the core's at its own:
 		// they differ by round-off), then when strained since the last one.
@@ -116,7 +119,31 @@ int YadeSync::writeBodies(SceneLink& s, const py::object& bodies, bool all) {
 		link->synced = true;
 		++written;
 	}
+	written += writeClumps(s, bodies, all);
 	resend_ = false;
+	return written;
+}
+
+// The clumps of concave blocks: the whole block's centroid, orientation and
+// velocity (the members are written above, part by part).
+int YadeSync::writeClumps(SceneLink& s, const py::object& bodies, bool all) {
+	const Names& n = names();
+	int written = 0;
+	for (const auto& [block, clump] : s.clumps()) {
+		const Block& b = s.world.block(block);
+		ClumpLink& link = *s.clumpLink(block);
+		if (b.fixed && link.synced && !resend_ && !all) continue;
+		BodyObjects& objects = clumpObjects_[block];
+		if (objects.state.is_none()) objects = lookUp(bodies, clump.bodyId);
+		PyObject* state = objects.state.ptr();
+		setVector(state, n.pos, b.centroid);
+		*quaternionValue_ = s.clumpOrientation(block);
+		check(PyObject_SetAttr(state, n.ori, quaternion_.ptr()));
+		setVector(state, n.vel, b.velocity.head<3>());
+		setVector(state, n.angVel, b.velocity.segment<3>(3));
+		link.synced = true;
+		++written;
+	}
 	return written;
 }
 
@@ -253,6 +280,7 @@ int YadeSync::writeInteractions(const std::vector<PairView>& current, const py::
 
 void YadeSync::forgetBodies() {
 	bodies_.clear();
+	clumpObjects_.clear();
 	resend_ = true;  // the new objects get everything, fixed blocks and vertices too
 }
 
@@ -268,6 +296,7 @@ void YadeSync::forgetInteraction(int id1, int id2) {
 YadeSync::Counters YadeSync::counters() const {
 	int bodies = 0;
 	for (const BodyObjects& b : bodies_) bodies += !b.state.is_none();
+	for (const auto& entry : clumpObjects_) bodies += !entry.second.state.is_none();
 	return Counters{bodies, static_cast<int>(pairs_.size()), forceReadBacks_};
 }
 

@@ -96,6 +96,8 @@ private:
 		py::object geom, phys;
 	};
 	BodyObjects& bodyObjects(const py::object& bodies, int block, int bodyId);
+	static BodyObjects lookUp(const py::object& bodies, int bodyId);
+	int writeClumps(SceneLink& s, const py::object& bodies, bool all);
 	PairObjects pairObjects(const py::object& interactions, int id1, int id2);
 	struct VertexList {
 		py::object list;               // of `count` Vector3 objects...
@@ -113,6 +115,7 @@ private:
 	Vector3* vectorValue_;
 	Eigen::Quaterniond* quaternionValue_;
 	std::vector<BodyObjects> bodies_;                  // per block
+	std::map<int, BodyObjects> clumpObjects_;          // per concave block's body: its clump's
 	bool resend_ = false;                              // write every body in full next (forgetBodies)
 	std::map<std::size_t, VertexList> vertexLists_;    // per vertex count
 	std::map<std::pair<int, int>, PairObjects> pairs_;  // the interactions this object keeps

@@ -374,6 +374,35 @@ py::tuple pythonColliderNames() {
 	return py::tuple(names);
 }
 
+// A concave block from its convex parts (lists of corners [m]); returns its body's index.
+int addConcaveBlock(SceneLink& s, const py::object& parts, double density, double young, double poisson,
+                    double frictionAngle, double cohesion, double tensileStrength, bool fixed, bool rigid) {
+	std::vector<std::vector<Vector3>> corners;
+	for (long k = 0, n = py::len(parts); k < n; ++k) corners.push_back(toPoints(parts[k], "part corners"));
+	return s.world.addConcaveBlock(corners, Material{density, young, poisson, frictionAngle, cohesion, tensileStrength},
+	                               fixed, rigid);
+}
+
+// Raises ValueError naming the problem if the parts and material cannot make a concave block.
+void checkConcaveBlock(const py::object& parts, double density, double young, double poisson, double frictionAngle,
+                       double cohesion, double tensileStrength) {
+	std::vector<std::vector<Vector3>> corners;
+	for (long k = 0, n = py::len(parts); k < n; ++k) corners.push_back(toPoints(parts[k], "part corners"));
+	makeConcaveBlock(corners, Material{density, young, poisson, frictionAngle, cohesion, tensileStrength}, false);
+}
+
+void linkClump(SceneLink& s, int block, int clumpId, const Eigen::Quaterniond& orientation) {
+	s.linkClump(block, clumpId, orientation);
+}
+
+// The parts of a block: one list of corners [m] per convex part (one for a convex block).
+py::list blockParts(const SceneLink& s, int i) {
+	py::list parts;
+	const Block& b = s.world.block(i);
+	for (int p = 0; p < b.partCount; ++p) parts.append(toList(s.world.block(i + p).vertices));
+	return parts;
+}
+
 py::object bodyToBlock(const SceneLink& s, int bodyId) {
 	const int block = s.blockOfBody(bodyId);
 	return block < 0 ? py::object() : py::object(block);
@@ -389,39 +418,32 @@ void loadState(SceneLink& s, const py::object& state) {
 	s.loadState(std::string(PyBytes_AS_STRING(state.ptr()), static_cast<std::size_t>(PyBytes_GET_SIZE(state.ptr()))));
 }
 
-}  // namespace
+// Concave blocks on the Scene class (World::addConcaveBlock, SceneLink::linkClump).
+void registerConcaveBlocks(py::class_<SceneLink, boost::noncopyable>& scene) {
+	scene
+	    .def("addConcaveBlock", &addConcaveBlock,
+	         (py::arg("parts"), py::arg("density"), py::arg("young"), py::arg("poisson"), py::arg("frictionAngle"),
+	          py::arg("cohesion"), py::arg("tensileStrength"), py::arg("fixed"), py::arg("rigid") = false),
+	         "A concave block of convex parts (World::addConcaveBlock); returns its body's block index.")
+	    .def("linkClump", &linkClump, (py::arg("block"), py::arg("clumpId"), py::arg("orientation")),
+	         "The YADE clump body that shows concave block `block` (its body's index), with its ori at creation.")
+	    .def("parts", &blockParts, "The corners [m] of each convex part of block i (one list for a convex block).")
+	    .def("partCount", +[](const SceneLink& s, int i) { return s.world.block(i).partCount; })
+	    .def("bodyOf", +[](const SceneLink& s, int i) { s.world.block(i); return s.world.bodyOf(i); },
+	         "The block whose unknowns block i moves with (a concave block's body for its parts).")
+	    .def("partPosition", +[](const SceneLink& s, int i) { return s.partPosition(i); },
+	         "Block i's own centroid [m] (a part of a concave block: the part's).")
+	    .def("clumps", +[](const SceneLink& s) {
+		    py::list out;
+		    for (const auto& [block, clump] : s.clumps()) out.append(py::make_tuple(block, clump.bodyId));
+		    return out;
+	    }, "[(block, clump id)] of the concave blocks' clumps.");
+}
 
-BOOST_PYTHON_MODULE(_core) {
-	py::docstring_options options(true, true, false);
-
-	py::def("checkBlock", &checkBlock,
-	        (py::arg("points"), py::arg("density"), py::arg("young"), py::arg("poisson"), py::arg("frictionAngle") = 0.0,
-	         py::arg("cohesion") = 0.0, py::arg("tensileStrength") = 0.0),
-	        "Raises ValueError naming the problem if the points and material cannot make a DDA block.");
-
-	py::scope().attr("__version__") = YADE_DDA_VERSION;  // CMakeLists.txt's project version
-
-	py::def("hullCorners", &pythonHullCorners, py::arg("points"),
-	        "Indices of the points [m] that are the corners of their convex hull, in input order (points inside the "
-	        "hull, repeats and points on a face or an edge of it within the coplanar tolerance are left out); "
-	        "ValueError for fewer than 4 points, NaN or inf, or no volume.");
-
-	py::scope().attr("mscMaxSegments") = kMaxCoverSegments;
-
-	py::def("settingsTable", &settingsTable,
-	        "Every DDAIntegrator parameter, one dict per row of pkg/dda/solver/Settings.def: name, member (the "
-	        "IntegratorSettings attribute; None for the engine's own), kind, default, range (its text), low, high, "
-	        "lowOpen, highOpen (numbers) or choices (names), unit, doc.");
-	py::def("colliderNames", &pythonColliderNames, "The broad phases of the core, by name (DESS first, the default).");
-	void registerRockMass(); registerRockMass();  // cutRockMass and its predicates (pkg/py/RockMass.cpp)
-
-	py::class_<IntegratorSettings> settingsClass(
-	    "IntegratorSettings", "Parameters of one DDA step (pkg/dda/solver/Settings.def; DDAIntegrator's docstring).");
-#define DDA_SETTING(type, name, engineName, value, range, unit, doc) \
-	settingsClass.def_readwrite(#name, &IntegratorSettings::name, doc);
-#include "dda/solver/Settings.def"
-
-	py::class_<SceneLink, boost::noncopyable>("Scene", "The DDA state of one YADE scene; the core is the source of truth.")
+// The Scene class (a SceneLink): blocks, contacts, views of a block, steps, saving.
+void registerScene() {
+	py::class_<SceneLink, boost::noncopyable> scene("Scene", "The DDA state of one YADE scene; the core is the source of truth.");
+	scene
 	    .def("addBlock", &addBlock,
 	         (py::arg("points"), py::arg("density"), py::arg("young"), py::arg("poisson"), py::arg("frictionAngle"),
 	          py::arg("cohesion"), py::arg("tensileStrength"), py::arg("fixed"), py::arg("rigid") = false))
@@ -463,6 +485,49 @@ BOOST_PYTHON_MODULE(_core) {
 	    .def("saveState", &saveState, "The whole DDA scene (blocks, contacts and their history, counters) as bytes.")
 	    .def("loadState", &loadState,
 	         "Replaces this scene by a state from saveState; ValueError naming the problem (and no change) if it cannot.");
+	registerConcaveBlocks(scene);
+}
+
+}  // namespace
+
+BOOST_PYTHON_MODULE(_core) {
+	py::docstring_options options(true, true, false);
+
+	py::def("checkBlock", &checkBlock,
+	        (py::arg("points"), py::arg("density"), py::arg("young"), py::arg("poisson"), py::arg("frictionAngle") = 0.0,
+	         py::arg("cohesion") = 0.0, py::arg("tensileStrength") = 0.0),
+	        "Raises ValueError naming the problem if the points and material cannot make a DDA block.");
+
+	py::def("checkConcaveBlock", &checkConcaveBlock,
+	        (py::arg("parts"), py::arg("density"), py::arg("young"), py::arg("poisson"), py::arg("frictionAngle") = 0.0,
+	         py::arg("cohesion") = 0.0, py::arg("tensileStrength") = 0.0),
+	        "Raises ValueError naming the problem if the convex parts (corner lists [m]) and material cannot make a "
+	        "concave block (a part no convex polyhedron, parts that overlap, share a face only in part, or are not "
+	        "one piece).");
+
+	py::scope().attr("__version__") = YADE_DDA_VERSION;  // CMakeLists.txt's project version
+
+	py::def("hullCorners", &pythonHullCorners, py::arg("points"),
+	        "Indices of the points [m] that are the corners of their convex hull, in input order (points inside the "
+	        "hull, repeats and points on a face or an edge of it within the coplanar tolerance are left out); "
+	        "ValueError for fewer than 4 points, NaN or inf, or no volume.");
+
+	py::scope().attr("mscMaxSegments") = kMaxCoverSegments;
+
+	py::def("settingsTable", &settingsTable,
+	        "Every DDAIntegrator parameter, one dict per row of pkg/dda/solver/Settings.def: name, member (the "
+	        "IntegratorSettings attribute; None for the engine's own), kind, default, range (its text), low, high, "
+	        "lowOpen, highOpen (numbers) or choices (names), unit, doc.");
+	py::def("colliderNames", &pythonColliderNames, "The broad phases of the core, by name (DESS first, the default).");
+	void registerRockMass(); registerRockMass();  // cutRockMass and its predicates (pkg/py/RockMass.cpp)
+
+	py::class_<IntegratorSettings> settingsClass(
+	    "IntegratorSettings", "Parameters of one DDA step (pkg/dda/solver/Settings.def; DDAIntegrator's docstring).");
+#define DDA_SETTING(type, name, engineName, value, range, unit, doc) \
+	settingsClass.def_readwrite(#name, &IntegratorSettings::name, doc);
+#include "dda/solver/Settings.def"
+
+	registerScene();
 
 	py::class_<YadeSync, boost::noncopyable>(
 	    "YadeSync",

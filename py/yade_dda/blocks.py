@@ -17,8 +17,9 @@ class BlockSpec:
                  'fixed', 'rigid', 'fixedPoints', 'loads', 'stress')
 
     def __init__(self, **kw):
-        for key in self.__slots__:
-            setattr(self, key, kw.get(key))
+        for cls in type(self).__mro__:
+            for key in getattr(cls, '__slots__', ()):
+                setattr(self, key, kw.get(key))
 
     def corners(self):
         """The block's corners [m], as given to ddaBlock."""
@@ -192,19 +193,52 @@ def ddaBlock(vertices, material=None, fixed=False, color=None, velocity=(0, 0, 0
         b = O.bodies.append(ddaBlock([(0,0,0),(1,0,0),(0,1,0),(1,1,0),(0,0,1),(1,0,1),(0,1,1),(1,1,1)],
                                      material=mat, velocity=(1, 0, 0)))
     """
-    if not isinstance(rigid, bool):
-        raise TypeError('rigid must be True or False, got %r' % (rigid,))
     if not isinstance(hull, bool):
         raise TypeError('hull must be True or False, got %r' % (hull,))
     points = _points(vertices)
     if hull:
         points = [points[i] for i in _core.hullCorners(points)]
+    o = _options(material, fixed, rigid, velocity, angularVelocity, fixedPoints, loads, stress, mask, color,
+                 cohesion, tensileStrength)
+    _core.checkBlock(points, *o.constants)
+    _requireYadeSize(points)
+    body, corners, yadePoints, shift = _body(points, hull, dict(fixed=fixed, wire=wire, color=o.color,
+                                                                 material=o.material, mask=mask))
+    if len(corners) != len(points):   # hull=True, and YADE merged corners away
+        _core.checkBlock(corners, *o.constants)
+    if not fixed:
+        body.state.vel = o.velocity
+        body.state.angVel = o.angularVelocity
+    spec = BlockSpec(points=yadePoints, shift=shift, **o.spec())
+    _scene.current().register(body, spec)
+    return body
+
+
+class _Options:
+    """The keywords ddaBlock and concaveBlock share, checked (see _options)."""
+
+    def __init__(self, **kw):
+        self.__dict__.update(kw)
+
+    def spec(self):
+        """The BlockSpec fields other than the corners."""
+        # Tuples: the spec waits in the scene's pending list until the body is appended, for every block of a
+        # scene built in one go, and an empty tuple is one shared object where an empty list is 56 bytes a block.
+        return dict(density=self.density, young=self.young, poisson=self.poisson, frictionAngle=self.frictionAngle,
+                    cohesion=self.cohesion, tensileStrength=self.tensileStrength, fixed=self.fixed,
+                    rigid=self.rigid, fixedPoints=tuple(self.fixedPoints), loads=tuple(self.loads),
+                    stress=self.stress)
+
+
+def _options(material, fixed, rigid, velocity, angularVelocity, fixedPoints, loads, stress, mask, color, cohesion,
+             tensileStrength):
+    """Checks the keywords a block shares with every other; raises TypeError or ValueError naming the problem."""
+    if not isinstance(rigid, bool):
+        raise TypeError('rigid must be True or False, got %r' % (rigid,))
     mat = _material(material)
     density, young, poisson, frictionAngle = _elasticConstants(mat)
     cohesion = _finiteNonNegative(cohesion, 'cohesion', 'Pa')
     tensileStrength = _finiteNonNegative(tensileStrength, 'tensileStrength', 'Pa')
-    _core.checkBlock(points, density, young, poisson, frictionAngle, cohesion, tensileStrength)
-    _requireYadeSize(points)
     velocity = vector(velocity, 'velocity')
     angularVelocity = vector(angularVelocity, 'angularVelocity')
     if fixed and (any(velocity) or any(angularVelocity)):
@@ -241,21 +275,11 @@ def ddaBlock(vertices, material=None, fixed=False, color=None, velocity=(0, 0, 0
     if not isinstance(mask, int) or isinstance(mask, bool):
         raise TypeError('mask must be an int, got %r' % (mask,))
     color = vector(color, 'color') if color is not None else _nextColor()
-
-    body, corners, yadePoints, shift = _body(points, hull, dict(fixed=fixed, wire=wire, color=color, material=mat,
-                                                                 mask=mask))
-    if len(corners) != len(points):   # hull=True, and YADE merged corners away
-        _core.checkBlock(corners, density, young, poisson, frictionAngle, cohesion, tensileStrength)
-    if not fixed:
-        body.state.vel = velocity
-        body.state.angVel = angularVelocity
-    # Tuples: the spec waits in the scene's pending list until the body is appended, for every block of a
-    # scene built in one go, and an empty tuple is one shared object where an empty list is 56 bytes a block.
-    spec = BlockSpec(points=yadePoints, shift=shift, density=density, young=young, poisson=poisson,
-                     frictionAngle=frictionAngle, cohesion=cohesion, tensileStrength=tensileStrength, fixed=bool(fixed), rigid=rigid,
-                     fixedPoints=tuple(fixedList), loads=tuple(loadList), stress=stress)
-    _scene.current().register(body, spec)
-    return body
+    return _Options(material=mat, density=density, young=young, poisson=poisson, frictionAngle=frictionAngle,
+                    cohesion=cohesion, tensileStrength=tensileStrength, fixed=bool(fixed), rigid=rigid,
+                    velocity=velocity, angularVelocity=angularVelocity, fixedPoints=fixedList, loads=loadList,
+                    stress=stress, color=color,
+                    constants=(density, young, poisson, frictionAngle, cohesion, tensileStrength))
 
 
 MAX_EXTENT = 1e4
@@ -325,3 +349,84 @@ def rigidBlock(vertices, material=None, **kw):
         b = O.bodies.append(rigidBlock(corners, material=rock))
     """
     return ddaBlock(vertices, material=material, rigid=True, **kw)
+
+
+class ConcaveSpec(BlockSpec):
+    """A concave block waiting for its clump: its parts' corners as given to YADE (each shifted by its own
+    shift, see _nearOrigin) and the member bodies, in part order."""
+
+    __slots__ = ('parts', 'members')
+
+    def partCorners(self):
+        """The corners of each part [m], as given to concaveBlock."""
+        return [BlockSpec(points=points, shift=shift).corners() for points, shift in self.parts]
+
+
+def concaveBlock(parts, material=None, fixed=False, color=None, velocity=(0, 0, 0), angularVelocity=(0, 0, 0),
+                 fixedPoints=(), loads=(), stress=None, mask=1, wire=False, cohesion=0.0, tensileStrength=0.0,
+                 rigid=False):
+    """A concave DDA block made of convex parts, as the member bodies of a YADE clump:
+    ``O.bodies.appendClumped(concaveBlock(parts, ...))`` returns ``(clumpId, memberIds)``.
+
+    It is one DDA block (Wu et al. 2014, Section 4): 12 unknowns (6 when
+    ``rigid``), one stress and strain, mass, centroid and inertia exact for
+    the union of the parts; the parts never contact each other, and the faces
+    they share are inside the block (no contact is made on them). Each part
+    is a member body with a ``Polyhedra`` shape (what YADE draws and exports);
+    the clump stands for the block: ``block(clumpId)`` (or a member's id)
+    gives its state, the sync writes the clump's position (the block's
+    centroid), orientation and velocity, and the members' own. Contacts, and
+    the interactions in ``O.interactions``, are between members, as for
+    YADE's clumps; ``O.forces`` holds each member's contact forces and the
+    clump's point loads and fixed points.
+
+    :param parts: a list of convex parts, each a list of corner points [m]
+        (every point a corner, as for ``ddaBlock``). They must meet face to
+        face without overlapping (a part's face lies wholly on a face of
+        another wherever two parts touch over an area) and make one piece.
+        ``cutRockMass`` output, or an L of boxes, qualifies; a part alone
+        makes an ordinary convex block.
+    :param material, fixed, color, velocity, angularVelocity, fixedPoints, loads, stress, mask, wire, cohesion,
+        tensileStrength, rigid: as for ``ddaBlock``, for the block as a whole
+        (velocities of its centroid [m/s] and about it [rad/s]). ``hull`` is
+        not offered: a part's corners are taken as given.
+
+    Raises ValueError naming the part and the problem (a part that is not a
+    convex polyhedron, two parts that overlap, share part of a face, or do
+    not make one piece) and TypeError for bad keyword types; nothing is made
+    then. At the first step a ValueError is raised if the members were not
+    appended together with ``O.bodies.appendClumped``.
+
+    Example (an L of three unit cubes)::
+
+        cube = lambda x, y: [(x+i, y+j, k) for i in (0, 1) for j in (0, 1) for k in (0, 1)]
+        clumpId, members = O.bodies.appendClumped(concaveBlock([cube(0, 0), cube(1, 0), cube(0, 1)]))
+        print(block(clumpId).volume)   # 3.0
+    """
+    try:
+        partList = list(parts)
+    except TypeError:
+        raise TypeError('parts must be a list of corner lists, got %r' % (parts,)) from None
+    points = []
+    for k, corners in enumerate(partList):
+        try:
+            points.append(_points(corners))
+        except (TypeError, ValueError) as error:
+            raise type(error)('part %d: %s' % (k, error)) from None
+    o = _options(material, fixed, rigid, velocity, angularVelocity, fixedPoints, loads, stress, mask, color,
+                 cohesion, tensileStrength)
+    _core.checkConcaveBlock(points, *o.constants)
+    for part in points:
+        _requireYadeSize(part)
+    members, shifted = [], []
+    for part in points:
+        body, _, yadePoints, shift = _body(part, False, dict(fixed=fixed, wire=wire, color=o.color,
+                                                             material=o.material, mask=mask))
+        if not fixed:
+            body.state.vel = o.velocity
+            body.state.angVel = o.angularVelocity
+        members.append(body)
+        shifted.append((yadePoints, shift))
+    spec = ConcaveSpec(parts=tuple(shifted), members=tuple(members), **o.spec())
+    _scene.current().register(members[0], spec)
+    return members

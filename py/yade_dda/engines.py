@@ -149,7 +149,7 @@ def _checkEngines(scene, engines):
     _guards.checkYadeContacts(scene, engines)
     for engine in engines:
         if isinstance(engine, wrapper.NewtonIntegrator):
-            for bodyId in scene.bodyOfBlock:
+            for bodyId in list(scene.bodyOfBlock) + list(scene.clumpMembers):   # concave blocks' clumps too
                 body = O.bodies[bodyId]
                 if body is not None and body.dynamic and (engine.mask & body.groupMask):
                     raise RuntimeError(

@@ -40,11 +40,20 @@ def checkInitialOverlaps(scene, settings):
     count = scene.core.blockCount()
     if not ready and first >= count:
         return
-    added = [(spec.corners(), spec.density, spec.young, spec.poisson, spec.fixed) for _, spec in ready]
+    # A concave block enters part by part (its parts touch face to face: no overlap among them).
+    added, addedIds = [], []
+    for body, spec in ready:
+        if hasattr(spec, 'members'):
+            for corners, member in zip(spec.partCorners(), spec.members):
+                added.append((corners, spec.density, spec.young, spec.poisson, spec.fixed))
+                addedIds.append(member.id)
+        else:
+            added.append((spec.corners(), spec.density, spec.young, spec.poisson, spec.fixed))
+            addedIds.append(body.id)
     overlaps = scene.core.initialOverlaps(first, added, settings)
     if overlaps:
         def bodyOf(index):
-            return scene.bodyOfBlock[index] if index < count else ready[index - count][0].id
+            return scene.bodyOfBlock[index] if index < count else addedIds[index - count]
         a, b, depth, tolerance = overlaps[0]
         more = ' (and %d more overlapping pairs)' % (len(overlaps) - 1) if len(overlaps) > 1 else ''
         raise ValueError(

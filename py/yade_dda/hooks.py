@@ -272,13 +272,16 @@ def unbalancedForce(useMaxForce=False):
     settings = getattr(scene, 'settings', None)
     ddaGravity = settings.gravity if settings is not None else None
     blocks = set(scene.bodyOfBlock)
+    clumps = scene.clumpMembers   # a concave block: its clump's force plus its members' (their contacts)
     forces = O.forces
     norms = []
     for body in O.bodies:
         if body is None or body.isClumpMember or not body.dynamic:
             continue
         f = forces.f(body.id, True) if not norms else forces.f(body.id)
-        gravity = ddaGravity if body.id in blocks else yadeGravity
+        for member in clumps.get(body.id, ()):
+            f = f + forces.f(member)
+        gravity = ddaGravity if body.id in blocks or body.id in clumps else yadeGravity
         if gravity is not None:
             f = f + body.state.mass * gravity
         norms.append(f.norm())

@@ -312,12 +312,15 @@ def _xyz(vector):
 def _blockArrays(scene, fileName):
     """Everything the blocks' file holds, as numpy arrays (dict)."""
     count = scene.core.blockCount() if scene is not None else 0
+    # One cell per convex part; a concave block's parts carry its state (its body's view).
     views = [_scene.BlockView(scene, index) for index in range(count)]
+    bodies = [views[scene.core.bodyOf(index)] for index in range(count)]
     points = numpy.array([_xyz(v) for view in views for v in view.vertices], dtype=numpy.float64).reshape(-1, 3)
-    centroids = numpy.array([_xyz(view.centroid) for view in views], dtype=numpy.float64).reshape(-1, 3)
-    rates = numpy.array([view.velocity for view in views], dtype=numpy.float64).reshape(-1, 12)
-    stress = numpy.array([view.stress for view in views], dtype=numpy.float64).reshape(-1, 6)
-    strain = numpy.array([view.strain for view in views], dtype=numpy.float64).reshape(-1, 6)
+    centroids = numpy.array([_xyz(scene.core.partPosition(index)) for index in range(count)],
+                            dtype=numpy.float64).reshape(-1, 3)
+    rates = numpy.array([view.velocity for view in bodies], dtype=numpy.float64).reshape(-1, 12)
+    stress = numpy.array([view.stress for view in bodies], dtype=numpy.float64).reshape(-1, 6)
+    strain = numpy.array([view.strain for view in bodies], dtype=numpy.float64).reshape(-1, 6)
     empty = numpy.zeros(0, dtype=numpy.int64)
     counts, stream, isVertex, owner, starts = _topology(scene, views) if count else (empty,) * 5
     firstPoint = numpy.concatenate([[0], numpy.cumsum(counts)[:-1]]).astype(numpy.int64)

@@ -27,7 +27,8 @@ class DDAScene:
         self.token = token
         self.core = _core.Scene()
         self.pending = []          # [(body, BlockSpec)] made by ddaBlock, not yet in the core
-        self.bodyOfBlock = []      # block index -> body id
+        self.bodyOfBlock = []      # block index -> body id (a concave block's parts: its members)
+        self.clumpMembers = {}     # clump id of a concave block -> its member ids
         self.syncTime = 0.0        # wall time of the last sync [s]
         self.syncParts = dict(bodies=0.0, views=0.0)   # its parts [s]: bodies, and views.update
         self.yadeSync = None       # _core.YadeSync, made by writer()
@@ -51,6 +52,9 @@ class DDAScene:
             if body.id < 0:
                 waiting.append((body, spec))   # made but not (yet) appended: not simulated
                 continue
+            if hasattr(spec, 'members'):
+                self._addConcave(spec)
+                continue
             index = self.core.addBlock(spec.corners(), spec.density, spec.young, spec.poisson, spec.frictionAngle,
                                        spec.cohesion, spec.tensileStrength, spec.fixed, bool(spec.rigid))
             self.core.linkBody(index, body.id, body.state.pos, body.state.ori, list(body.shape.v))
@@ -67,6 +71,38 @@ class DDAScene:
             assert index == len(self.bodyOfBlock)
             self.bodyOfBlock.append(body.id)
         self.pending = waiting
+
+    def _addConcave(self, spec):
+        """A concave block (concaveBlock) whose members are in O.bodies: into the core, each member linked to
+        its part and the clump to the block."""
+        ids = [member.id for member in spec.members]
+        clumps = {O.bodies[i].clumpId if i >= 0 and O.bodies[i] is not None else -1 for i in ids}
+        if len(clumps) != 1 or -1 in clumps or clumps == {ids[0]}:
+            raise ValueError('the members of a concave block (bodies %s) must be appended together, as one clump: '
+                             'O.bodies.appendClumped(concaveBlock(parts, ...)); they are not one clump now (clump '
+                             'ids %s)' % (ids, sorted(clumps)))
+        clumpId = clumps.pop()
+        clump = O.bodies[clumpId]
+        index = self.core.addConcaveBlock(spec.partCorners(), spec.density, spec.young, spec.poisson,
+                                          spec.frictionAngle, spec.cohesion, spec.tensileStrength, spec.fixed,
+                                          bool(spec.rigid))
+        for part, member in enumerate(spec.members):
+            self.core.linkBody(index + part, member.id, member.state.pos, member.state.ori, list(member.shape.v))
+        self.core.linkClump(index, clumpId, clump.state.ori)
+        if not spec.fixed:
+            # The clump's state when a script set it after appendClumped, else what concaveBlock was given.
+            state = clump.state if (clump.state.vel.norm() > 0 or clump.state.angVel.norm() > 0) else \
+                spec.members[0].state
+            self.core.setVelocity(index, state.vel, state.angVel)
+        for point, stiffness in spec.fixedPoints:
+            self.core.addFixedPoint(index, point, stiffness)
+        for point, force in spec.loads:
+            self.core.addPointLoad(index, point, force)
+        if spec.stress is not None:
+            self.core.setStress(index, spec.stress)
+        assert index == len(self.bodyOfBlock)
+        self.bodyOfBlock.extend(ids)
+        self.clumpMembers[clumpId] = tuple(ids)
 
     def blockIndex(self, body):
         """Block index of a body (a Body or an id); raises for non-DDA bodies."""
@@ -193,6 +229,8 @@ def restoreState():
     scene = DDAScene(newToken())
     scene.core = core
     scene.bodyOfBlock = list(bodies)
+    scene.clumpMembers = {clumpId: tuple(bodies[index:index + core.partCount(index)])
+                          for index, clumpId in core.clumps()}
     scene.cover = tuple(info['cover']) if info.get('cover') is not None else None
     # The blocks the saved scene had already checked for initial overlaps (guards.checkInitialOverlaps)
     # stay checked: checked again, blocks pressed into each other by their contacts (an impact, a block
@@ -374,7 +412,33 @@ class BlockView:
     rotation = property(lambda self: self._core.rotation(self.index), doc='rotation since creation (Quaternion)')
     fixed = property(lambda self: self._core.isFixed(self.index))
     rigid = property(lambda self: self._core.isRigid(self.index), doc='a rigid block: 6 unknowns, no strain or stress')
+    partCount = property(lambda self: 1, doc='number of convex parts (concaveBlock: more than 1)')
+    parts = property(lambda self: [self.vertices], doc="each convex part's current corners [m]")
     fixedPoints = property(lambda self: self._core.fixedPoints(self.index), doc='current fixed-point positions [m]')
+
+
+class ConcaveBlockView(BlockView):
+    """Read-only view of a concave block (concaveBlock): its state is its body's (SI units); its geometry is
+    every part's. ``vertices`` lists the corners of all parts, part after part, and ``faces`` and ``edges``
+    index into it (the faces the parts share are included, once per part); ``parts`` gives each part's
+    corners alone."""
+
+    partCount = property(lambda self: self._core.partCount(self.index), doc='number of convex parts')
+    parts = property(lambda self: self._core.parts(self.index), doc="each part's current corners [m]")
+
+    @property
+    def vertices(self):
+        return [x for part in self.parts for x in part]
+
+    def _allParts(self, what):
+        out, offset = [], 0
+        for p in range(self.partCount):
+            out.extend(tuple(v + offset for v in item) for item in what(self.index + p))
+            offset += len(self._core.vertices(self.index + p))
+        return out
+
+    faces = property(lambda self: self._allParts(self._core.faces), doc='faces of every part, into vertices')
+    edges = property(lambda self: self._allParts(self._core.edges), doc='edges of every part, into vertices')
 
 
 class ContactView:
@@ -470,7 +534,8 @@ class Ig2_DDABlock_DDABlock_DDAContact:
 def block(body):
     """The core state of a DDA body (a Body or its id) as a BlockView."""
     scene = _require()
-    return BlockView(scene, scene.blockIndex(body))
+    index = scene.blockIndex(body)
+    return ConcaveBlockView(scene, index) if scene.core.partCount(index) > 1 else BlockView(scene, index)
 
 
 def blockOf(body):
