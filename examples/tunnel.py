@@ -210,6 +210,9 @@ def main(argv):
     while O.time < args.time - 1e-9:
         O.run(10, True)
     wall = time.time() - t0
+    if args.vtk:
+        from yade_dda.recorder import record
+        record(os.path.join(args.vtk, 'tunnel-'))     # the final state too
     e = stats()['energy']
     drop = {i: start[i][2] - block(ids[i]).centroid[2] for i in range(len(rock)) if i not in held}
     fell = sorted((i for i in drop if drop[i] > 0.05), key=lambda i: -drop[i])
@@ -221,8 +224,10 @@ def main(argv):
               % (i, rock[i].volume, c[0], c[1], c[2], drop[i],
                  'falls, round %d' % falls[i] if i in falls else 'locked' if i in locked else 'friction decides'))
     stayed = [i for i in drop if drop[i] <= 0.05]
-    print('  %d free blocks stayed (largest drop %.2e m); theory said %d fall, DDA %d fell'
-          % (len(stayed), max((drop[i] for i in stayed), default=0.0), len(falls), len(fell)))
+    most = max(stayed, key=lambda i: drop[i]) if stayed else None
+    print('  %d free blocks stayed (the largest drop %.2e m, block %s: %s); theory said %d fall, DDA %d fell'
+          % (len(stayed), drop.get(most, 0.0), most, 'locked' if most in locked else 'friction decides',
+             len(falls), len(fell)))
     names = ('kinetic', 'gravity', 'strain', 'contact', 'friction', 'damping', 'loads', 'contactChanges')
     change = {k: e[k] - e0[k] for k in names}
     balance = sum(change[k] for k in names[:6]) - change['loads'] - change['contactChanges']
