@@ -7,6 +7,11 @@ along their normal, their length proportional to the normal force; the time
 of the output in a corner.
 
     /usr/bin/python3 tools/render_vtk.py vtk_pile/pile- --out doc/vtk_pile.png
+    /usr/bin/python3 tools/render_vtk.py tunnel/tunnel- --out doc/tunnel.png --colour displacement \
+        --cut 0 1 0 10.5 --view -0.6 -1 0.35 --arrows 0
+
+(--colour: the cell array the moving blocks are coloured by; --cut: fixed blocks beyond a plane left
+out, to see inside; --view: where the camera looks from; --arrows 0: no contact arrows.)
 
 (PREFIX may also be a directory holding one '*blocks.pvd'.) Debian 12's VTK
 9.1 renders through X only (no EGL or OSMesa build), so without a DISPLAY
@@ -80,19 +85,47 @@ def colourMap(low, high):
     return lut
 
 
-def blocksActors(grid):
-    """The moving blocks' surfaces coloured by vonMises, the fixed ones grey, edges drawn; and the colour map."""
+def cutAway(grid, plane):
+    """grid without its fixed blocks whose centre lies beyond plane (a, b, c, d): a x + b y + c z > d,
+    so that a section shows what the fixed blocks hide (a tunnel)."""
+    import numpy as np
+    from vtkmodules.util.numpy_support import numpy_to_vtk
+    shown = np.zeros(grid.GetNumberOfCells())
+    fixed = grid.GetCellData().GetArray('fixed')
+    for k in range(grid.GetNumberOfCells()):
+        ids = grid.GetCell(k).GetPointIds()
+        centre = np.mean([grid.GetPoint(ids.GetId(j)) for j in range(ids.GetNumberOfIds())], axis=0)
+        shown[k] = 0 if fixed.GetValue(k) and np.dot(plane[:3], centre) > plane[3] else 1
+    array = numpy_to_vtk(shown, deep=True)
+    array.SetName('shown')
+    grid.GetCellData().AddArray(array)
+    from vtkmodules.vtkCommonDataModel import vtkDataObject
+    from vtkmodules.vtkFiltersCore import vtkThreshold
+    keep = vtkThreshold()
+    keep.SetInputData(grid)
+    keep.SetInputArrayToProcess(0, 0, 0, vtkDataObject.FIELD_ASSOCIATION_CELLS, 'shown')
+    keep.SetThresholdFunction(vtkThreshold.THRESHOLD_BETWEEN)
+    keep.SetLowerThreshold(1)
+    keep.SetUpperThreshold(1)
+    keep.Update()
+    return keep.GetOutput()
+
+
+def blocksActors(grid, colour='vonMises'):
+    """The moving blocks' surfaces coloured by `colour` (vonMises, or the magnitude of displacement), the
+    fixed ones grey, edges drawn; and the colour map."""
     from vtkmodules.vtkRenderingCore import vtkActor, vtkPolyDataMapper
     moving = threshold(grid, 'cells', 'fixed', 0, 0)
-    high = moving.GetCellData().GetArray('vonMises').GetRange()[1] if moving.GetNumberOfCells() else 0.0
+    high = moving.GetCellData().GetArray(colour).GetRange(-1)[1] if moving.GetNumberOfCells() else 0.0
     lut = colourMap(0.0, high if high > 0 else 1.0)
+    lut.SetVectorModeToMagnitude()
     actors = []
     for blocks, coloured in ((moving, True), (threshold(grid, 'cells', 'fixed', 1, 1), False)):
         mapper = vtkPolyDataMapper()
         mapper.SetInputData(blocks)
         if coloured:
             mapper.SetScalarModeToUseCellFieldData()
-            mapper.SelectColorArray('vonMises')
+            mapper.SelectColorArray(colour)
             mapper.SetLookupTable(lut)
             mapper.SetUseLookupTableScalarRange(True)
             mapper.ScalarVisibilityOn()
@@ -147,7 +180,8 @@ def contactsActor(poly, length):
     return actor, points.GetNumberOfPoints()
 
 
-def render(blocksPvd, contactsPvd, out, size=(1200, 900)):
+def render(blocksPvd, contactsPvd, out, size=(1200, 900), colour='vonMises', view=(-1, -1.8, 1.3), cut=None,
+           arrows=0.5):
     from vtkmodules.vtkIOImage import vtkPNGWriter
     from vtkmodules.vtkRenderingAnnotation import vtkScalarBarActor
     from vtkmodules.vtkRenderingCore import vtkRenderer, vtkRenderWindow, vtkTextActor, vtkWindowToImageFilter
@@ -155,19 +189,21 @@ def render(blocksPvd, contactsPvd, out, size=(1200, 900)):
     import vtkmodules.vtkRenderingOpenGL2  # noqa: F401  (the render window's implementation)
     time, blocksPath = lastOutput(blocksPvd)
     grid = read(blocksPath)
+    if cut is not None:
+        grid = cutAway(grid, cut)
     renderer = vtkRenderer()
     renderer.SetBackground(1, 1, 1)
-    actors, lut = blocksActors(grid)
+    actors, lut = blocksActors(grid, colour)
     for actor in actors:
         renderer.AddActor(actor)
     closed = 0
     if os.path.isfile(contactsPvd):
-        arrows, closed = contactsActor(read(lastOutput(contactsPvd)[1]), length=0.5)
-        if arrows is not None:
-            renderer.AddActor(arrows)
+        glyphs, closed = contactsActor(read(lastOutput(contactsPvd)[1]), length=arrows)
+        if glyphs is not None and arrows > 0:
+            renderer.AddActor(glyphs)
     bar = vtkScalarBarActor()
     bar.SetLookupTable(lut)
-    bar.SetTitle('von Mises stress [Pa]')
+    bar.SetTitle({'vonMises': 'von Mises stress [Pa]', 'displacement': 'displacement [m]'}.get(colour, colour))
     bar.SetNumberOfLabels(5)
     bar.SetLabelFormat('%.2g')
     bar.SetPosition(0.84, 0.12)
@@ -182,15 +218,15 @@ def render(blocksPvd, contactsPvd, out, size=(1200, 900)):
     renderer.AddActor2D(bar)
     caption = vtkTextActor()
     fixed = int(sum(grid.GetCellData().GetArray('fixed').GetValue(k) for k in range(grid.GetNumberOfCells())))
-    caption.SetInput('t = %.3f s   %d blocks (%d fixed, grey)   %d closed contacts (arrows: normal force)'
-                     % (time, grid.GetNumberOfCells(), fixed, closed))
+    caption.SetInput('t = %.3f s   %d blocks shown (%d fixed, grey)   %d closed contacts%s'
+                     % (time, grid.GetNumberOfCells(), fixed, closed, ' (arrows: normal force)' if arrows > 0 else ''))
     caption.GetTextProperty().SetColor(0, 0, 0)
     caption.GetTextProperty().SetFontSize(22)
     caption.SetPosition(20, 20)
     renderer.AddActor2D(caption)
     camera = renderer.GetActiveCamera()   # from the south-west, above; framing the moving blocks
     camera.SetViewUp(0, 0, 1)
-    camera.SetPosition(-1, -1.8, 1.3)
+    camera.SetPosition(*view)
     camera.SetFocalPoint(0, 0, 0)
     renderer.ResetCamera(actors[0].GetBounds() if actors[0].GetMapper().GetInput().GetNumberOfCells()
                          else grid.GetBounds())
@@ -214,6 +250,12 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('prefix', help="a DDAVTKRecorder fileName (e.g. vtk_pile/pile-) or a directory")
     parser.add_argument('--out', default='vtk_pile.png')
+    parser.add_argument('--colour', default='vonMises', help="the blocks' cell array: vonMises or displacement")
+    parser.add_argument('--view', type=float, nargs=3, default=(-1, -1.8, 1.3),
+                        help='direction from the moving blocks to the camera')
+    parser.add_argument('--cut', type=float, nargs=4, metavar=('A', 'B', 'C', 'D'),
+                        help='leave out the fixed blocks whose centre has A x + B y + C z > D')
+    parser.add_argument('--arrows', type=float, default=0.5, help='length of the largest contact arrow [m]; 0: none')
     args = parser.parse_args()
     if not os.environ.get('DISPLAY') and not os.environ.get('RENDER_VTK_XVFB'):
         if shutil.which('xvfb-run') is None:
@@ -222,7 +264,7 @@ def main():
         os.execvp('xvfb-run', ['xvfb-run', '-a', '-s', '-screen 0 1600x1200x24', sys.executable,
                                os.path.abspath(__file__)] + sys.argv[1:])
     blocks, contacts = seriesOf(args.prefix)
-    render(blocks, contacts, args.out)
+    render(blocks, contacts, args.out, colour=args.colour, view=args.view, cut=args.cut, arrows=args.arrows)
 
 
 if __name__ == '__main__':
