@@ -7,6 +7,7 @@
 // dda::InputError (a std::invalid_argument) -> ValueError, std::out_of_range ->
 // IndexError, anything else -> RuntimeError.
 #include "SceneLink.hpp"
+#include "dda/geometry/ConvexParts.hpp"
 #include "YadeSync.hpp"
 #include "dda/collider/ColliderFactory.hpp"
 #include "dda/solver/InitialOverlaps.hpp"
@@ -391,6 +392,19 @@ void checkConcaveBlock(const py::object& parts, double density, double young, do
 	makeConcaveBlock(corners, Material{density, young, poisson, frictionAngle, cohesion, tensileStrength}, false);
 }
 
+// conformParts on corner lists [m]: the parts split so that shared faces match (lists of tuples).
+py::list pythonConformParts(const py::object& parts) {
+	std::vector<std::vector<Vector3>> corners;
+	for (long k = 0, n = py::len(parts); k < n; ++k) corners.push_back(toPoints(parts[k], "part corners"));
+	py::list out;
+	for (const std::vector<Vector3>& part : conformParts(corners)) {
+		py::list points;
+		for (const Vector3& x : part) points.append(py::make_tuple(x.x(), x.y(), x.z()));
+		out.append(points);
+	}
+	return out;
+}
+
 void linkClump(SceneLink& s, int block, int clumpId, const Eigen::Quaterniond& orientation) {
 	s.linkClump(block, clumpId, orientation);
 }
@@ -504,6 +518,10 @@ BOOST_PYTHON_MODULE(_core) {
 	        "Raises ValueError naming the problem if the convex parts (corner lists [m]) and material cannot make a "
 	        "concave block (a part no convex polyhedron, parts that overlap, share a face only in part, or are not "
 	        "one piece).");
+
+	py::def("conformParts", &pythonConformParts, py::arg("parts"),
+	        "The convex parts (corner lists [m]) split so that wherever two share a face region, one face lies "
+	        "wholly on the other (what a concave block needs); ValueError naming the problem.");
 
 	py::scope().attr("__version__") = YADE_DDA_VERSION;  // CMakeLists.txt's project version
 

@@ -382,18 +382,18 @@ def concaveBlock(parts, material=None, fixed=False, color=None, velocity=(0, 0, 
 
     :param parts: a list of convex parts, each a list of corner points [m]
         (every point a corner, as for ``ddaBlock``). They must meet face to
-        face without overlapping (a part's face lies wholly on a face of
-        another wherever two parts touch over an area) and make one piece.
-        ``cutRockMass`` output, or an L of boxes, qualifies; a part alone
-        makes an ordinary convex block.
+        face without overlapping and make one piece. Where two parts share
+        only part of each other's faces (staggered bricks), one is split
+        along the other's face edges (``conformParts`` in the core), so the
+        block may have more parts, and members, than given:
+        ``block(clumpId).partCount``. A part alone makes a convex block.
     :param material, fixed, color, velocity, angularVelocity, fixedPoints, loads, stress, mask, wire, cohesion,
         tensileStrength, rigid: as for ``ddaBlock``, for the block as a whole
         (velocities of its centroid [m/s] and about it [rad/s]). ``hull`` is
         not offered: a part's corners are taken as given.
 
     Raises ValueError naming the part and the problem (a part that is not a
-    convex polyhedron, two parts that overlap, share part of a face, or do
-    not make one piece) and TypeError for bad keyword types; nothing is made
+    convex polyhedron, two parts that overlap or do not make one piece) and TypeError for bad keyword types; nothing is made
     then. At the first step a ValueError is raised if the members were not
     appended together with ``O.bodies.appendClumped``.
 
@@ -415,6 +415,7 @@ def concaveBlock(parts, material=None, fixed=False, color=None, velocity=(0, 0, 
             raise type(error)('part %d: %s' % (k, error)) from None
     o = _options(material, fixed, rigid, velocity, angularVelocity, fixedPoints, loads, stress, mask, color,
                  cohesion, tensileStrength)
+    points = [[tuple(x) for x in part] for part in _core.conformParts(points)]
     _core.checkConcaveBlock(points, *o.constants)
     for part in points:
         _requireYadeSize(part)

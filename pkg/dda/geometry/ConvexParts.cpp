@@ -90,9 +90,16 @@ bool insidePolygon(const Vector3& x, const ConvexPolyhedron& p, const std::vecto
 	return true;
 }
 
-// Whether parts a and b share a face region of positive area; throws when
-// neither of the two faces lies wholly on the other (see the header).
-bool shareFace(const PartView& a, int ia, const PartView& b, int ib, double tolerance) {
+// A face f of part a and a face g of part b that share a region of positive
+// area, neither lying wholly on the other (see the header).
+struct PartialFaces {
+	int f = -1, g = -1;
+	double area = 0;
+};
+
+// Whether parts a and b share a face region of positive area; a pair of faces
+// of theirs that share one only in part goes to `partial` (the first found).
+bool shareFace(const PartView& a, const PartView& b, double tolerance, PartialFaces* partial) {
 	const ConvexPolyhedron& A = *a.part;
 	const ConvexPolyhedron& B = *b.part;
 	bool shared = false;
@@ -113,14 +120,8 @@ bool shareFace(const PartView& a, int ia, const PartView& b, int ib, double tole
 			bool fCovered = true, gCovered = true;
 			for (int v : A.faces[f]) fCovered = fCovered && insidePolygon(A.vertices[v], B, B.faces[g], b.normals[g], tolerance);
 			for (int v : B.faces[g]) gCovered = gCovered && insidePolygon(B.vertices[v], A, A.faces[f], nf, tolerance);
-			if (!fCovered && !gCovered) {
-				std::ostringstream message;
-				message << "parts " << ia << " and " << ib << " of the concave block share " << area
-				        << " m^2 of face " << f << " of part " << ia << " and face " << g << " of part " << ib
-				        << ", but neither face lies wholly on the other; split the parts so that each face they "
-				        << "share is a whole face of at least one of them";
-				throw InputError(message.str());
-			}
+			if (!fCovered && !gCovered && partial && partial->f < 0)
+				*partial = PartialFaces{static_cast<int>(f), static_cast<int>(g), area};
 			shared = true;
 		}
 	}
@@ -129,15 +130,106 @@ bool shareFace(const PartView& a, int ia, const PartView& b, int ib, double tole
 
 }  // namespace
 
+namespace {
+
+PartView viewOf(const ConvexPolyhedron& part) {
+	PartView view;
+	view.part = &part;
+	for (const Vector3& x : part.vertices) view.box.extend(x);
+	for (const auto& face : part.faces) view.normals.push_back(faceNormal(part.vertices, face));
+	return view;
+}
+
+// The pieces of `part` below and above the plane n . x = d (each the hull of
+// its side's corners, those within `tolerance` of the plane on both, and the
+// edge crossings, each computed once for both), or nothing when the plane
+// leaves every corner on one side (within the tolerance).
+std::vector<std::vector<Vector3>> splitPart(const ConvexPolyhedron& part, const Vector3& n, double d,
+                                            double tolerance) {
+	std::vector<double> side;
+	bool below = false, above = false;
+	for (const Vector3& x : part.vertices) {
+		side.push_back(n.dot(x) - d);
+		below = below || side.back() < -tolerance;
+		above = above || side.back() > tolerance;
+	}
+	if (!below || !above) return {};
+	std::vector<Vector3> lower, upper;
+	for (std::size_t v = 0; v < part.vertices.size(); ++v) {
+		if (side[v] <= tolerance) lower.push_back(part.vertices[v]);
+		if (side[v] >= -tolerance) upper.push_back(part.vertices[v]);
+	}
+	for (const auto& e : part.edges) {
+		const double sa = side[e[0]], sb = side[e[1]];
+		if ((sa < -tolerance && sb > tolerance) || (sa > tolerance && sb < -tolerance)) {
+			const Vector3& a = part.vertices[e[0]];
+			const Vector3& b = part.vertices[e[1]];
+			const Vector3 x = a + (sa / (sa - sb)) * (b - a);
+			lower.push_back(x);
+			upper.push_back(x);
+		}
+	}
+	return {lower, upper};
+}
+
+// One cut that resolves a partly shared face pair, or false when none is left.
+bool conformOnce(std::vector<std::vector<Vector3>>& parts) {
+	std::vector<ConvexPolyhedron> polyhedra;
+	for (std::size_t p = 0; p < parts.size(); ++p) {
+		try {
+			polyhedra.push_back(buildConvexPolyhedron(parts[p]));
+		} catch (const InputError& error) {
+			throw InputError("part " + std::to_string(p) + " of the concave block: " + error.what());
+		}
+	}
+	std::vector<PartView> views;
+	for (const ConvexPolyhedron& p : polyhedra) views.push_back(viewOf(p));
+	for (std::size_t a = 0; a < parts.size(); ++a)
+		for (std::size_t b = 0; b < parts.size(); ++b) {
+			if (a == b) continue;
+			const double tolerance =
+			    kCoplanarRelativeTolerance * std::max(views[a].box.diagonal().norm(), views[b].box.diagonal().norm());
+			Eigen::AlignedBox3d grown = views[a].box;
+			grown.min().array() -= tolerance;
+			grown.max().array() += tolerance;
+			if (!grown.intersects(views[b].box)) continue;
+			PartialFaces partial;
+			shareFace(views[a], views[b], tolerance, &partial);
+			if (partial.f < 0) continue;
+			// Cut b by the first plane through an edge of a's face f, perpendicular to f, that cuts it.
+			const ConvexPolyhedron& A = polyhedra[a];
+			const std::vector<int>& face = A.faces[partial.f];
+			const Vector3& nf = views[a].normals[partial.f];
+			for (std::size_t k = 0; k < face.size(); ++k) {
+				const Vector3& s = A.vertices[face[k]];
+				const Vector3 m = nf.cross(A.vertices[face[(k + 1) % face.size()]] - s).normalized();
+				std::vector<std::vector<Vector3>> pieces = splitPart(polyhedra[b], m, m.dot(s), tolerance);
+				if (pieces.empty()) continue;
+				for (const std::vector<Vector3>& piece : pieces) {
+					try {
+						buildConvexPolyhedron(piece);
+					} catch (const InputError& error) {
+						throw InputError("parts " + std::to_string(a) + " and " + std::to_string(b) +
+						                 " of the concave block share part of a face, and cutting part " +
+						                 std::to_string(b) + " along it leaves a piece that is no block (" +
+						                 error.what() + "); give parts whose shared faces match");
+					}
+				}
+				parts[b] = pieces[0];
+				parts.insert(parts.begin() + static_cast<long>(b) + 1, pieces[1]);
+				return true;
+			}
+		}
+	return false;
+}
+
+}  // namespace
+
 void checkConvexParts(const std::vector<ConvexPolyhedron>& parts) {
 	const int n = static_cast<int>(parts.size());
 	if (n == 0) throw InputError("a concave block needs at least one part");
-	std::vector<PartView> views(n);
-	for (int p = 0; p < n; ++p) {
-		views[p].part = &parts[p];
-		for (const Vector3& x : parts[p].vertices) views[p].box.extend(x);
-		for (const auto& face : parts[p].faces) views[p].normals.push_back(faceNormal(parts[p].vertices, face));
-	}
+	std::vector<PartView> views;
+	for (const ConvexPolyhedron& part : parts) views.push_back(viewOf(part));
 	std::vector<int> root(n);
 	std::iota(root.begin(), root.end(), 0);
 	auto find = [&](int p) {
@@ -160,7 +252,16 @@ void checkConvexParts(const std::vector<ConvexPolyhedron>& parts) {
 				        << "meet face to face without overlapping";
 				throw InputError(message.str());
 			}
-			if (shareFace(views[a], a, views[b], b, tolerance)) root[find(a)] = find(b);
+			PartialFaces partial;
+			if (shareFace(views[a], views[b], tolerance, &partial)) root[find(a)] = find(b);
+			if (partial.f >= 0) {
+				std::ostringstream message;
+				message << "parts " << a << " and " << b << " of the concave block share " << partial.area
+				        << " m^2 of face " << partial.f << " of part " << a << " and face " << partial.g << " of part "
+				        << b << ", but neither face lies wholly on the other; split the parts so that each face they "
+				        << "share is a whole face of at least one of them (conformParts does)";
+				throw InputError(message.str());
+			}
 		}
 	for (int p = 1; p < n; ++p)
 		if (find(p) != find(0)) {
@@ -169,6 +270,17 @@ void checkConvexParts(const std::vector<ConvexPolyhedron>& parts) {
 			        << "other parts; a concave block is one piece: its parts must meet face to face";
 			throw InputError(message.str());
 		}
+}
+
+
+std::vector<std::vector<Vector3>> conformParts(const std::vector<std::vector<Vector3>>& parts) {
+	std::vector<std::vector<Vector3>> conformed = parts;
+	constexpr std::size_t kMostParts = 1000;
+	while (conformOnce(conformed))
+		if (conformed.size() > kMostParts)
+			throw InputError("making the concave block's shared faces match split it into more than " +
+			                 std::to_string(kMostParts) + " parts; give parts whose shared faces match");
+	return conformed;
 }
 
 MassProperties unionMassProperties(const std::vector<MassProperties>& parts) {

@@ -27,6 +27,20 @@ namespace dda {
 // A single part is accepted (a convex block).
 void checkConvexParts(const std::vector<ConvexPolyhedron>& parts);
 
+// The same solid as `parts` (convex corner lists [m] meeting face to face
+// without overlapping), with parts split so that wherever two parts share a
+// face region, one of the two faces lies wholly on the other (what
+// checkConvexParts requires). A part b whose face g shares area with a face f
+// of a part a, neither lying wholly on the other, is cut by the planes through
+// f's edges perpendicular to f (those that cut b): the piece of b on f then has
+// its face within f, the others touch f along lines at most. The two pieces of
+// a cut share the cut's corners exactly (each edge crossing computed once).
+// Parts that need no cut are returned unchanged, in order; a cut part's pieces
+// take its place. Throws InputError naming the parts when a part is not a
+// convex polyhedron, when a cut would leave a piece thinner than the
+// tolerance that buildConvexPolyhedron refuses, or after 1000 parts.
+std::vector<std::vector<Vector3>> conformParts(const std::vector<std::vector<Vector3>>& parts);
+
 // The volume, centroid and second moments about the centroid of the union of
 // disjoint parts, each given with its own about its own centroid: volumes
 // add, the centroid is the volume-weighted mean, and each part's second

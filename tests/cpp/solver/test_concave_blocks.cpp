@@ -10,6 +10,7 @@
 #include "dda/collider/ColliderFactory.hpp"
 #include "dda/core/StateStream.hpp"
 #include "dda/geometry/ConvexParts.hpp"
+#include "dda/geometry/MassProperties.hpp"
 
 #include <gtest/gtest.h>
 
@@ -277,6 +278,51 @@ TEST(ConcaveBlocks, RestoredWorldWithConcaveBlocksContinuesBitwise) {
 		EXPECT_EQ(original.block(b).velocity, restored.block(b).velocity) << "block " << b;
 		EXPECT_EQ(original.block(b).body, restored.block(b).body);
 		EXPECT_EQ(original.block(b).partCount, restored.block(b).partCount);
+	}
+}
+
+// conformParts: staggered bricks and random stacks of boxes whose faces
+// overlap only in part (seeded) become parts that makeConcaveBlock accepts,
+// with the union's volume, centroid and second moments unchanged.
+TEST(ConcaveBlocks, ConformedPartsAreAcceptedAndKeepTheUnionsMassProperties) {
+	auto wholeOf = [](const std::vector<std::vector<Vector3>>& parts) {
+		std::vector<MassProperties> each;
+		for (const auto& corners : parts) {
+			const ConvexPolyhedron p = buildConvexPolyhedron(corners);
+			each.push_back(computeMassProperties(p.vertices, p.faces));
+		}
+		return unionMassProperties(each);
+	};
+	std::vector<std::vector<std::vector<Vector3>>> cases;
+	cases.push_back({boxPoints(Vector3(0, 0, 0), Vector3(2, 1, 1)), boxPoints(Vector3(1, 0, 1), Vector3(3, 1, 2))});
+	cases.push_back({boxPoints(Vector3(0, 0, 0), Vector3(2, 2, 1)), boxPoints(Vector3(1, 1, 1), Vector3(3, 3, 2))});
+	const unsigned seed = 41;
+	std::mt19937 rng(seed);
+	std::uniform_real_distribution<double> unit(0, 1);
+	for (int trial = 0; trial < 6; ++trial) {  // towers of 3 boxes, each on the one below, shifted at random
+		std::vector<std::vector<Vector3>> parts;
+		Vector3 lo(0, 0, 0);
+		Vector3 size(1 + unit(rng), 1 + unit(rng), 0.5 + unit(rng));
+		for (int k = 0; k < 3; ++k) {
+			parts.push_back(boxPoints(lo, lo + size));
+			const Vector3 next(1 + unit(rng), 1 + unit(rng), 0.5 + unit(rng));
+			lo = Vector3(lo.x() + (size.x() - 0.2) * unit(rng), lo.y() + (size.y() - 0.2) * unit(rng), lo.z() + size.z());
+			size = next;
+		}
+		cases.push_back(parts);
+	}
+	for (std::size_t c = 0; c < cases.size(); ++c) {
+		SCOPED_TRACE("case " + std::to_string(c) + " (seed " + std::to_string(seed) + ")");
+		const std::vector<std::vector<Vector3>> conformed = conformParts(cases[c]);
+		EXPECT_GT(conformed.size(), cases[c].size());
+		World world;
+		const int b = world.addConcaveBlock(conformed, Material{}, false);
+		const MassProperties whole = wholeOf(cases[c]);
+		const Block& block = world.block(b);
+		EXPECT_NEAR(block.volume, whole.volume, 1e-12 * whole.volume);
+		EXPECT_LT((block.centroid - whole.centroid).norm(), 1e-12 * std::cbrt(whole.volume));
+		EXPECT_LT((block.secondMoment - whole.secondMoment).norm(), 1e-12 * whole.secondMoment.norm());
+		EXPECT_EQ(conformParts(conformed).size(), conformed.size());  // already conforming: unchanged
 	}
 }
 
