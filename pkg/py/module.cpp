@@ -7,6 +7,7 @@
 // dda::InputError (a std::invalid_argument) -> ValueError, std::out_of_range ->
 // IndexError, anything else -> RuntimeError.
 #include "SceneLink.hpp"
+#include "dda/geometry/ConvexDecomposition.hpp"
 #include "dda/geometry/ConvexParts.hpp"
 #include "YadeSync.hpp"
 #include "dda/collider/ColliderFactory.hpp"
@@ -405,6 +406,23 @@ py::list pythonConformParts(const py::object& parts) {
 	return out;
 }
 
+// convexDecomposition of a closed surface: points [m] and triangles (index triples); lists of tuples.
+py::list pythonConvexDecomposition(const py::object& points, const py::object& triangles) {
+	std::vector<std::array<int, 3>> tris;
+	for (long t = 0, n = py::len(triangles); t < n; ++t) {
+		const py::object tri = triangles[t];
+		if (py::len(tri) != 3) throw InputError("triangle " + std::to_string(t) + " must have 3 corner indices");
+		tris.push_back({py::extract<int>(tri[0])(), py::extract<int>(tri[1])(), py::extract<int>(tri[2])()});
+	}
+	py::list out;
+	for (const std::vector<Vector3>& part : convexDecomposition(toPoints(points, "surface points"), tris)) {
+		py::list corners;
+		for (const Vector3& x : part) corners.append(py::make_tuple(x.x(), x.y(), x.z()));
+		out.append(corners);
+	}
+	return out;
+}
+
 void linkClump(SceneLink& s, int block, int clumpId, const Eigen::Quaterniond& orientation) {
 	s.linkClump(block, clumpId, orientation);
 }
@@ -519,6 +537,9 @@ BOOST_PYTHON_MODULE(_core) {
 	        "concave block (a part no convex polyhedron, parts that overlap, share a face only in part, or are not "
 	        "one piece).");
 
+	py::def("convexDecomposition", &pythonConvexDecomposition, (py::arg("points"), py::arg("triangles")),
+	        "The convex parts (corner lists [m]) of the solid a closed triangulated surface bounds (CGAL's "
+	        "convex_decomposition_3, exact); ValueError naming the problem (open, non-manifold, self-intersecting).");
 	py::def("conformParts", &pythonConformParts, py::arg("parts"),
 	        "The convex parts (corner lists [m]) split so that wherever two share a face region, one face lies "
 	        "wholly on the other (what a concave block needs); ValueError naming the problem.");

@@ -362,9 +362,9 @@ class ConcaveSpec(BlockSpec):
         return [BlockSpec(points=points, shift=shift).corners() for points, shift in self.parts]
 
 
-def concaveBlock(parts, material=None, fixed=False, color=None, velocity=(0, 0, 0), angularVelocity=(0, 0, 0),
+def concaveBlock(parts=None, material=None, fixed=False, color=None, velocity=(0, 0, 0), angularVelocity=(0, 0, 0),
                  fixedPoints=(), loads=(), stress=None, mask=1, wire=False, cohesion=0.0, tensileStrength=0.0,
-                 rigid=False):
+                 rigid=False, surface=None):
     """A concave DDA block made of convex parts, as the member bodies of a YADE clump:
     ``O.bodies.appendClumped(concaveBlock(parts, ...))`` returns ``(clumpId, memberIds)``.
 
@@ -387,6 +387,13 @@ def concaveBlock(parts, material=None, fixed=False, color=None, velocity=(0, 0, 
         along the other's face edges (``conformParts`` in the core), so the
         block may have more parts, and members, than given:
         ``block(clumpId).partCount``. A part alone makes a convex block.
+    :param surface: instead of ``parts``, ``(points, triangles)``: a closed
+        triangulated surface (points [m], triangles as index triples, either
+        orientation) bounding the block, any shape without self-intersection;
+        it is split into convex parts with CGAL's exact
+        ``convex_decomposition_3`` (cuts through the reflex edges), then as
+        above. ValueError names an open, non-manifold or self-intersecting
+        surface.
     :param material, fixed, color, velocity, angularVelocity, fixedPoints, loads, stress, mask, wire, cohesion,
         tensileStrength, rigid: as for ``ddaBlock``, for the block as a whole
         (velocities of its centroid [m/s] and about it [rad/s]). ``hull`` is
@@ -403,6 +410,14 @@ def concaveBlock(parts, material=None, fixed=False, color=None, velocity=(0, 0, 
         clumpId, members = O.bodies.appendClumped(concaveBlock([cube(0, 0), cube(1, 0), cube(0, 1)]))
         print(block(clumpId).volume)   # 3.0
     """
+    if (parts is None) == (surface is None):
+        raise TypeError('concaveBlock takes parts or surface=(points, triangles), exactly one of them')
+    if surface is not None:
+        try:
+            surfacePoints, triangles = surface
+        except (TypeError, ValueError):
+            raise TypeError('surface must be (points, triangles), got %r' % (surface,)) from None
+        parts = _core.convexDecomposition(_points(surfacePoints), [tuple(t) for t in triangles])
     try:
         partList = list(parts)
     except TypeError:
