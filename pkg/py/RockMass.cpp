@@ -3,6 +3,7 @@
 // user's joint dicts and calls this with normalised ones; the result comes
 // back as plain tuples and dicts, which rockmass.py wraps.
 #include "dda/core/Errors.hpp"
+#include "dda/geometry/ConvexParts.hpp"
 #include "dda/geometry/RockMassCutter.hpp"
 
 #include <boost/python.hpp>
@@ -183,6 +184,33 @@ int pythonVertexSide(const py::object& planes, int i, int j, int k, int l) {
 
 py::tuple pythonPole(double dip, double dipDirection) { return tupleOf(poleOf(dip, dipDirection)); }
 
+// sharedFaces of blocks given as (corners, faces): [(a, f, b, g, area [m^2])], the caller's face indices.
+py::list pythonSharedFaces(const py::object& blocks) {
+	std::vector<ConvexPolyhedron> polyhedra;
+	for (long i = 0, n = py::len(blocks); i < n; ++i) {
+		ConvexPolyhedron p;
+		p.vertices = pointsOf(blocks[i][0]);
+		const py::object faces = blocks[i][1];
+		for (long f = 0, m = py::len(faces); f < m; ++f) {
+			std::vector<int> face;
+			for (long k = 0, c = py::len(faces[f]); k < c; ++k) {
+				const int v = py::extract<int>(faces[f][k])();
+				if (v < 0 || v >= static_cast<int>(p.vertices.size()))
+					throw InputError("block " + std::to_string(i) + ": face " + std::to_string(f) + " has corner " +
+					                 std::to_string(v) + ", out of range");
+				face.push_back(v);
+			}
+			if (face.size() < 3) throw InputError("block " + std::to_string(i) + ": face " + std::to_string(f) +
+			                                      " has fewer than 3 corners");
+			p.faces.push_back(face);
+		}
+		polyhedra.push_back(std::move(p));
+	}
+	py::list out;
+	for (const SharedFace& s : sharedFaces(polyhedra)) out.append(py::make_tuple(s.a, s.f, s.b, s.g, s.area));
+	return out;
+}
+
 }  // namespace
 }  // namespace dda
 
@@ -196,6 +224,9 @@ void registerRockMass() {
 	py::def("vertexSide", &pythonVertexSide,
 	        (py::arg("planes"), py::arg("i"), py::arg("j"), py::arg("k"), py::arg("l")),
 	        "Exact sign of n_l . x - d_l at the intersection of planes i, j, k; planes are (normal, offset) pairs.");
+	py::def("sharedFaces", &pythonSharedFaces, py::arg("blocks"),
+	        "Faces of different blocks ((corners, faces) each) that are opposed, coplanar and share area: "
+	        "[(a, f, b, g, area [m^2])], a < b (dda/geometry/ConvexParts.hpp).");
 	py::def("pole", &pythonPole, (py::arg("dip"), py::arg("dipDirection")),
 	        "Upward unit normal of a plane of dip and dip direction [deg]: (sin d sin a, sin d cos a, cos d).");
 }

@@ -6,11 +6,13 @@ blocks share faces bit for bit. This module checks the user's input, names
 what is wrong, and wraps the result. Units: m, m^3; angles in degrees.
 """
 import gc
+import hashlib
 import math
 import numbers
 
 from . import _core
-from .blocks import ddaBlock
+from ._yade import O
+from .blocks import ddaBlock, concaveBlock
 
 _SET_KEYS = ('dip', 'dipDirection', 'spacing', 'origin', 'persistence', 'fisherK', 'spacingDistribution',
              'spacingStd')
@@ -78,6 +80,10 @@ class RockMass:
         self.stats = raw['stats']
         self.merged = self.stats['mergedSlivers']
         self.seed = seed
+        # The DDA blocks, each a tuple of block indices: one for a convex block, several for a concave
+        # one (cutRockMass(..., concave=True) joins them).
+        self.groups = [(i,) for i in range(len(self.blocks))]
+        self.jointArea = self.absentArea = 0.0   # concave=True: non-persistent joints' touching area [m^2]
 
     def __len__(self):
         return len(self.blocks)
@@ -89,12 +95,72 @@ class RockMass:
         return self.blocks[i]
 
     def __repr__(self):
-        return 'RockMass(%d blocks, %d slivers, %d merged, domain %.6g m^3)' % (
-            len(self.blocks), len(self.slivers), self.merged, self.domainVolume)
+        concave = sum(len(g) > 1 for g in self.groups)
+        return 'RockMass(%d blocks, %d slivers, %d merged, domain %.6g m^3%s)' % (
+            len(self.blocks), len(self.slivers), self.merged, self.domainVolume,
+            ', %d concave blocks' % concave if concave else '')
 
     def ddaBlocks(self, **kw):
-        """``[ddaBlock(b.corners, **kw) for b in self.blocks]``: bodies for ``O.bodies.append``."""
+        """``[ddaBlock(b.corners, **kw) for b in self.blocks]``: bodies for ``O.bodies.append``, one per
+        convex block (the parts of a concave block each alone; see ``append`` for the blocks as grouped)."""
         return [ddaBlock(b.corners, **kw) for b in self.blocks]
+
+    def append(self, fixed=False, **kw):
+        """Appends every block of ``groups`` to ``O.bodies``: a single block with ``ddaBlock``, a group of
+        several (a concave block) with ``O.bodies.appendClumped(concaveBlock(parts))``. ``fixed``: a bool,
+        or a function of the group's ``RockBlock`` list returning one; other keywords go to ``ddaBlock`` /
+        ``concaveBlock`` (``material=...``). Returns the body id of each group, in order: the clump's id
+        for a concave block (what ``block()`` takes)."""
+        ids = []
+        for group in self.groups:
+            blocks = [self.blocks[i] for i in group]
+            isFixed = fixed(blocks) if callable(fixed) else fixed
+            if len(group) == 1:
+                ids.append(O.bodies.append(ddaBlock(blocks[0].corners, fixed=isFixed, **kw)))
+            else:
+                ids.append(O.bodies.appendClumped(concaveBlock([b.corners for b in blocks], fixed=isFixed, **kw))[0])
+        return ids
+
+    def _join(self, persistences):
+        """groups for concave=True: blocks joined across the faces the domain's parts share (no joint there)
+        and across the faces of a non-persistent joint plane where the joint is absent (a draw per pair of
+        touching blocks: absent with probability 1 - persistence)."""
+        n = len(self.blocks)
+        root = list(range(n))
+
+        def find(i):
+            while root[i] != i:
+                root[i] = root[root[i]]
+                i = root[i]
+            return i
+
+        identity = [tuple(sorted(b.planes)) for b in self.blocks]   # a block is known by its planes
+        self.jointArea = self.absentArea = 0.0
+        for a, f, b, g, area in _core.sharedFaces([(blk.corners, blk.faces) for blk in self.blocks]):
+            plane = self.planes[self.blocks[a].planes[f]]
+            if plane.kind == 'domain':
+                join = True
+            elif plane.kind in _JOINT_KINDS and persistences[plane.source] < 1:
+                draw = _uniform(self.seed, self.blocks[a].planes[f], *sorted((identity[a], identity[b])))
+                join = draw >= persistences[plane.source]
+                self.jointArea += area
+                self.absentArea += area if join else 0.0
+            else:
+                join = False
+            if join:
+                ra, rb = find(a), find(b)
+                root[max(ra, rb)] = min(ra, rb)
+        members = {}
+        for i in range(n):
+            members.setdefault(find(i), []).append(i)
+        self.groups = [tuple(members[r]) for r in sorted(members)]
+
+
+def _uniform(seed, *what):
+    """A number in [0, 1) that depends only on the seed and `what` (a hash; the same on every run and
+    machine, unlike Python's hash() of strings)."""
+    digest = hashlib.blake2b(repr((seed,) + what).encode('ascii'), digest_size=8).digest()
+    return int.from_bytes(digest, 'little') / 2.0 ** 64
 
 
 def pole(dip, dipDirection):
@@ -253,7 +319,7 @@ def _joint(entry, i):
     return _jointSet(entry, where)
 
 
-def cutRockMass(domain, jointSets=(), seed=0, minVolume=None, checkShapes=True):
+def cutRockMass(domain, jointSets=(), seed=0, minVolume=None, checkShapes=True, concave=False):
     """The blocks of a rock domain cut by joint sets, single joints and excavations.
 
     :param domain: the corners [m] of a convex block, or a list of such corner lists: the convex parts
@@ -285,11 +351,17 @@ def cutRockMass(domain, jointSets=(), seed=0, minVolume=None, checkShapes=True):
         those that cannot be merged are returned in ``slivers``, not in ``blocks``. 0 keeps every block.
     :param checkShapes: also merge, or return in ``slivers``, blocks whose corners ``ddaBlock`` would
         refuse (corners closer than 1e-12 of the block's size, or within 1e-9 of it of a face plane).
+    :param concave: False (default): every block is convex and a DDA block of its own; a non-persistent
+        joint stops at a block's face, never inside a block. True (3DEC's joined blocks): the blocks are
+        cut as convex cells and then joined into concave blocks (``groups``) across the faces the domain's
+        parts share (the domain's inside, no joint) and across the faces of a non-persistent plane where
+        the joint is absent: every plane with ``persistence`` p < 1 cuts every block it crosses, and each
+        pair of blocks it separates stays apart (a joint) with probability p, drawn from the seed, the
+        plane and the two blocks (so about p of the plane's area inside the rock is joint:
+        ``jointArea``, ``absentArea``). ``append()`` adds them to ``O.bodies``.
     :returns: a ``RockMass``: ``blocks`` (``RockBlock``: ``corners``, ``faces``, ``planes``, ``joints``,
-        ``volume``, ``part``), ``slivers``, ``merged``, ``planes``, ``domainVolume``, ``stats``.
-
-    Every block is convex: a non-persistent joint stops at a block's face, never inside a block (that
-    would make it concave). Raises ValueError naming the problem: a domain part that is not a closed
+        ``volume``, ``part``), ``groups`` (the DDA blocks as tuples of block indices), ``slivers``,
+        ``merged``, ``planes``, ``domainVolume``, ``stats``. Raises ValueError naming the problem: a domain part that is not a closed
     convex block (fewer than 4 corners, all in one plane, a corner inside the others' hull), parts that
     overlap, NaN, ``spacing <= 0``, a dip outside [0, 90], an unknown key, ``persistence`` outside (0, 1].
 
@@ -316,12 +388,20 @@ def cutRockMass(domain, jointSets=(), seed=0, minVolume=None, checkShapes=True):
             raise ValueError('minVolume must be >= 0 m^3, got %r' % (minVolume,))
     if not isinstance(checkShapes, bool):
         raise ValueError('checkShapes must be True or False, got %r' % (checkShapes,))
+    if not isinstance(concave, bool):
+        raise ValueError('concave must be True or False, got %r' % (concave,))
+    persistences = [j.get('persistence', 1.0) for j in joints]
+    if concave:   # every plane cuts fully; the joins decide where a joint is absent
+        joints = [dict(j, persistence=1.0) if 'persistence' in j else j for j in joints]
     # Python's cyclic collector would traverse the millions of new tuples (acyclic) again and again:
     # paused while they are made (0.5 s of 1.7 on 50,000 blocks), and put back as it was.
     collecting = gc.isenabled()
     gc.disable()
     try:
-        return RockMass(_core.cutRockMass(parts, joints, int(seed) % 2 ** 64, minVolume, checkShapes), int(seed))
+        rock = RockMass(_core.cutRockMass(parts, joints, int(seed) % 2 ** 64, minVolume, checkShapes), int(seed))
     finally:
         if collecting:
             gc.enable()
+    if concave:
+        rock._join(persistences)
+    return rock

@@ -7,6 +7,7 @@
 #include <limits>
 #include <numeric>
 #include <sstream>
+#include <tuple>
 
 namespace dda {
 
@@ -99,7 +100,8 @@ struct PartialFaces {
 
 // Whether parts a and b share a face region of positive area; a pair of faces
 // of theirs that share one only in part goes to `partial` (the first found).
-bool shareFace(const PartView& a, const PartView& b, double tolerance, PartialFaces* partial) {
+bool shareFace(const PartView& a, const PartView& b, double tolerance, PartialFaces* partial,
+               std::vector<PartialFaces>* every = nullptr) {
 	const ConvexPolyhedron& A = *a.part;
 	const ConvexPolyhedron& B = *b.part;
 	bool shared = false;
@@ -122,6 +124,7 @@ bool shareFace(const PartView& a, const PartView& b, double tolerance, PartialFa
 			for (int v : B.faces[g]) gCovered = gCovered && insidePolygon(B.vertices[v], A, A.faces[f], nf, tolerance);
 			if (!fCovered && !gCovered && partial && partial->f < 0)
 				*partial = PartialFaces{static_cast<int>(f), static_cast<int>(g), area};
+			if (every) every->push_back(PartialFaces{static_cast<int>(f), static_cast<int>(g), area});
 			shared = true;
 		}
 	}
@@ -281,6 +284,34 @@ std::vector<std::vector<Vector3>> conformParts(const std::vector<std::vector<Vec
 			throw InputError("making the concave block's shared faces match split it into more than " +
 			                 std::to_string(kMostParts) + " parts; give parts whose shared faces match");
 	return conformed;
+}
+
+std::vector<SharedFace> sharedFaces(const std::vector<ConvexPolyhedron>& polyhedra) {
+	const int n = static_cast<int>(polyhedra.size());
+	std::vector<PartView> views;
+	for (const ConvexPolyhedron& p : polyhedra) views.push_back(viewOf(p));
+	std::vector<int> order(n);
+	std::iota(order.begin(), order.end(), 0);
+	std::sort(order.begin(), order.end(), [&](int x, int y) { return views[x].box.min().x() < views[y].box.min().x(); });
+	std::vector<SharedFace> found;
+	for (int s = 0; s < n; ++s)
+		for (int t = s + 1; t < n; ++t) {
+			const int a = std::min(order[s], order[t]), b = std::max(order[s], order[t]);
+			const double tolerance = kCoplanarRelativeTolerance *
+			                         std::max(views[a].box.diagonal().norm(), views[b].box.diagonal().norm());
+			if (views[order[t]].box.min().x() > views[order[s]].box.max().x() + tolerance) break;
+			Eigen::AlignedBox3d grown = views[a].box;
+			grown.min().array() -= tolerance;
+			grown.max().array() += tolerance;
+			if (!grown.intersects(views[b].box)) continue;
+			std::vector<PartialFaces> pairs;
+			shareFace(views[a], views[b], tolerance, nullptr, &pairs);
+			for (const PartialFaces& p : pairs) found.push_back(SharedFace{a, p.f, b, p.g, p.area});
+		}
+	std::sort(found.begin(), found.end(), [](const SharedFace& x, const SharedFace& y) {
+		return std::tie(x.a, x.b, x.f, x.g) < std::tie(y.a, y.b, y.f, y.g);
+	});
+	return found;
 }
 
 MassProperties unionMassProperties(const std::vector<MassProperties>& parts) {

@@ -41,6 +41,18 @@ void checkConvexParts(const std::vector<ConvexPolyhedron>& parts);
 // tolerance that buildConvexPolyhedron refuses, or after 1000 parts.
 std::vector<std::vector<Vector3>> conformParts(const std::vector<std::vector<Vector3>>& parts);
 
+// Two faces of different polyhedra that are opposed, coplanar (within
+// kCoplanarRelativeTolerance x the larger bounding-box diagonal) and overlap
+// with positive area: face f of polyhedron a and face g of polyhedron b
+// (a < b), the area they share [m^2] (cutRockMass's joining of blocks).
+struct SharedFace {
+	int a, f, b, g;
+	double area;
+};
+// Every such pair among `polyhedra` (vertices and faces; edges are not read),
+// pairs of bodies found by sorting boxes along x.
+std::vector<SharedFace> sharedFaces(const std::vector<ConvexPolyhedron>& polyhedra);
+
 // The volume, centroid and second moments about the centroid of the union of
 // disjoint parts, each given with its own about its own centroid: volumes
 // add, the centroid is the volume-weighted mean, and each part's second

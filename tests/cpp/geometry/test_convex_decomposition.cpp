@@ -131,3 +131,28 @@ TEST(ConvexDecomposition, BadSurfacesAreRefusedNamingTheProblem) {
 
 }  // namespace
 }  // namespace dda
+
+namespace dda {
+namespace {
+// sharedFaces on a grid of unit cubes: exactly the neighbours' faces, each 1 m^2.
+TEST(ConvexParts, SharedFacesOfACubeGridAreTheNeighboursFaces) {
+	const int nx = 3, ny = 2, nz = 2;
+	std::vector<ConvexPolyhedron> cubes;
+	for (int i = 0; i < nx; ++i)
+		for (int j = 0; j < ny; ++j)
+			for (int k = 0; k < nz; ++k) {
+				std::vector<Vector3> corners;
+				for (int c = 0; c < 8; ++c) corners.emplace_back(i + (c & 1), j + (c >> 1 & 1), k + (c >> 2 & 1));
+				cubes.push_back(buildConvexPolyhedron(corners));
+			}
+	const std::vector<SharedFace> shared = sharedFaces(cubes);
+	EXPECT_EQ(static_cast<int>(shared.size()), (nx - 1) * ny * nz + nx * (ny - 1) * nz + nx * ny * (nz - 1));
+	for (const SharedFace& s : shared) {
+		EXPECT_NEAR(s.area, 1.0, 1e-12);
+		const Vector3 d = cubes[s.b].vertices[0] - cubes[s.a].vertices[0];
+		EXPECT_NEAR(d.norm(), 1.0, 1e-12);  // neighbours only
+		EXPECT_LT(s.a, s.b);
+	}
+}
+}  // namespace
+}  // namespace dda

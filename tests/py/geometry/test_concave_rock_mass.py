@@ -1,0 +1,97 @@
+"""cutRockMass(..., concave=True): 3DEC's joined blocks (issue 19: part lists for concaveBlock).
+
+Oracles: joined blocks lie in one joint cell (the same side of every joint plane, exact from the
+corners) and no two groups of one cell touch; volumes add up to the domain's; the fraction of a
+non-persistent plane's area left as joint is its persistence within the binomial sampling error; the
+same seed gives the same groups; every group is a block concaveBlock accepts; a jointed cube of concave
+blocks rests on a fixed floor. SI units.
+"""
+import math
+
+import pytest
+
+import yade_dda
+from yade_dda import O, DDAIntegrator, cutRockMass, ddaBlock
+from yade_dda import _core
+
+from helpers import box, material
+
+BENCH = [[(x, y, z) for x in (0, 20) for y in (0, 10) for z in (0, 10)],     # the slope's toe
+         [(x, y, z) for x in (0, 10) for y in (0, 10) for z in (10, 20)]]    # its bench above
+BENCH_SETS = [dict(dip=60, dipDirection=90, spacing=4, origin=(1, 0, 0)), dict(dip=90, dipDirection=0, spacing=5)]
+CUBE = [(x, y, z) for x in (0, 12) for y in (0, 12) for z in (0, 12)]
+
+
+def side(rock, block, plane):
+    """-1 or +1: the side of plane `plane` that `block` lies on (its corners' mean; no corner is across)."""
+    p = rock.planes[plane]
+    c = [sum(x[k] for x in rock.blocks[block].corners) / len(rock.blocks[block].corners) for k in range(3)]
+    return 1 if sum(p.normal[k] * c[k] for k in range(3)) > p.offset else -1
+
+
+def cellOf(rock, block, planes):
+    return tuple(side(rock, block, p) for p in planes)
+
+
+def test_blocks_across_the_parts_of_a_domain_are_joined_within_their_joint_cell():
+    rock = cutRockMass(BENCH, BENCH_SETS, concave=True)
+    print(rock)
+    joints = [i for i, p in enumerate(rock.planes) if p.kind == 'set']
+    assert sum(len(g) > 1 for g in rock.groups) > 0
+    assert sorted(i for g in rock.groups for i in g) == list(range(len(rock.blocks)))
+    assert sum(rock.blocks[i].volume for i in range(len(rock.blocks))) == pytest.approx(3000, rel=1e-12)
+    for group in rock.groups:
+        cells = {cellOf(rock, i, joints) for i in group}
+        assert len(cells) == 1, (group, cells)              # one joint cell
+        assert len({rock.blocks[i].part for i in group}) == len(group)   # one block per part at most here
+    # Groups of the same joint cell do not touch (else they would be one).
+    groupOf = {i: k for k, g in enumerate(rock.groups) for i in g}
+    for a, f, b, g, area in _core.sharedFaces([(blk.corners, blk.faces) for blk in rock.blocks]):
+        if groupOf[a] != groupOf[b]:
+            assert rock.planes[rock.blocks[a].planes[f]].kind == 'set', (a, b, area)
+    # Without concave=True every block stands alone.
+    assert all(len(g) == 1 for g in cutRockMass(BENCH, BENCH_SETS).groups)
+
+
+@pytest.mark.parametrize('seed', [3, 4])
+def test_a_non_persistent_set_leaves_its_persistence_of_joint_area(seed):
+    p = 0.5
+    rock = cutRockMass(CUBE, [dict(dip=0, dipDirection=0, spacing=1.5, origin=(0, 0, 0.7), persistence=p),
+                              dict(dip=80, dipDirection=70, spacing=1.7), dict(dip=85, dipDirection=160, spacing=1.9)],
+                       seed=seed, concave=True)
+    pairs = len(rock.blocks)   # about one touching pair per block on the horizontal planes
+    fraction = 1 - rock.absentArea / rock.jointArea
+    sigma = math.sqrt(p * (1 - p) / pairs) * 2   # area-weighted: allow twice the count's standard error
+    print(rock, 'joint fraction %.4f (p %.2f, sigma %.4f)' % (fraction, p, sigma))
+    assert abs(fraction - p) < 4 * sigma
+    assert sum(b.volume for b in rock.blocks) == pytest.approx(12 ** 3, rel=1e-12)
+    again = cutRockMass(CUBE, [dict(dip=0, dipDirection=0, spacing=1.5, origin=(0, 0, 0.7), persistence=p),
+                               dict(dip=80, dipDirection=70, spacing=1.7), dict(dip=85, dipDirection=160, spacing=1.9)],
+                        seed=seed, concave=True)
+    assert again.groups == rock.groups
+    for group in rock.groups:
+        if len(group) > 1:
+            _core.checkConcaveBlock([rock.blocks[i].corners for i in group], 2600, 1e10, 0.25)
+
+
+def test_a_cube_of_concave_blocks_rests_on_a_fixed_floor(scene):
+    rho, g, young = 2600.0, 9.81, 1e10
+    rock = cutRockMass(CUBE, [dict(dip=90, dipDirection=90, spacing=3), dict(dip=90, dipDirection=0, spacing=4),
+                              dict(dip=0, dipDirection=0, spacing=3, persistence=0.5)], seed=1, concave=True)
+    assert sum(len(g) > 1 for g in rock.groups) > 0
+    mat = material(O, young=young, density=rho, frictionDeg=30)
+    O.bodies.append(ddaBlock(box((-2, -2, -1), (14, 14, 0)), material=mat, fixed=True))
+    ids = rock.append(material=mat, rigid=True)
+    assert len(ids) == len(rock.groups)
+    start = {i: tuple(yade_dda.block(i).centroid) for i in ids}
+    O.engines = [DDAIntegrator(dt=1e-3, gravity=(0, 0, -g), maxDisplacement=1e-3)]
+    O.run(100, True)
+    moved = max(math.dist(start[i], tuple(yade_dda.block(i).centroid)) for i in ids)
+    print(rock, 'largest displacement %.3g m' % moved)
+    assert moved < 1e-5   # the contact springs' settlement (test_rock_mass's rigid bound)
+    assert sum(yade_dda.block(i).volume for i in ids) == pytest.approx(12 ** 3, rel=1e-12)
+
+
+def test_concave_must_be_a_bool():
+    with pytest.raises(ValueError, match='concave must be True or False'):
+        cutRockMass(CUBE, [], concave=1)
