@@ -60,17 +60,21 @@ class DDAScene:
             self.core.linkBody(index, body.id, body.state.pos, body.state.ori, list(body.shape.v))
             # The body's state is read here, so a script may still set
             # b.state.vel / b.state.angVel between ddaBlock() and the first step.
-            if not spec.fixed:
-                self.core.setVelocity(index, body.state.vel, body.state.angVel)
-            for point, stiffness in spec.fixedPoints:
-                self.core.addFixedPoint(index, point, stiffness)
-            for point, force in spec.loads:
-                self.core.addPointLoad(index, point, force)
-            if spec.stress is not None:
-                self.core.setStress(index, spec.stress)
+            self._setState(index, spec, body.state)
             assert index == len(self.bodyOfBlock)
             self.bodyOfBlock.append(body.id)
         self.pending = waiting
+
+    def _setState(self, index, spec, state):
+        """A new block's velocity (from `state`, a YADE State), fixed points, loads and initial stress."""
+        if not spec.fixed:
+            self.core.setVelocity(index, state.vel, state.angVel)
+        for point, stiffness in spec.fixedPoints:
+            self.core.addFixedPoint(index, point, stiffness)
+        for point, force in spec.loads:
+            self.core.addPointLoad(index, point, force)
+        if spec.stress is not None:
+            self.core.setStress(index, spec.stress)
 
     def _addConcave(self, spec):
         """A concave block (concaveBlock) whose members are in O.bodies: into the core, each member linked to
@@ -89,17 +93,10 @@ class DDAScene:
         for part, member in enumerate(spec.members):
             self.core.linkBody(index + part, member.id, member.state.pos, member.state.ori, list(member.shape.v))
         self.core.linkClump(index, clumpId, clump.state.ori)
-        if not spec.fixed:
-            # The clump's state when a script set it after appendClumped, else what concaveBlock was given.
-            state = clump.state if (clump.state.vel.norm() > 0 or clump.state.angVel.norm() > 0) else \
-                spec.members[0].state
-            self.core.setVelocity(index, state.vel, state.angVel)
-        for point, stiffness in spec.fixedPoints:
-            self.core.addFixedPoint(index, point, stiffness)
-        for point, force in spec.loads:
-            self.core.addPointLoad(index, point, force)
-        if spec.stress is not None:
-            self.core.setStress(index, spec.stress)
+        # The clump's state when a script set it after appendClumped, else what concaveBlock was given.
+        state = clump.state if (clump.state.vel.norm() > 0 or clump.state.angVel.norm() > 0) else \
+            spec.members[0].state
+        self._setState(index, spec, state)
         assert index == len(self.bodyOfBlock)
         self.bodyOfBlock.extend(ids)
         self.clumpMembers[clumpId] = tuple(ids)

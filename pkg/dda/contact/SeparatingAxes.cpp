@@ -6,6 +6,11 @@ namespace dda::narrow {
 
 namespace {
 
+// A face faces an internal face of the other block (searchFaceAxes) when
+// their outward normals are opposed within about 8 degrees: a block turned
+// that little against a seam still lies on the neighbour's side of it.
+constexpr double kFacingInternalCosine = 0.99;
+
 // Do the Gauss-map arcs of edge ea of A (a1, a2 its faces' normals) and of
 // edge eb of B (c, d: minus its faces' normals) cross (strictly)? Signs of
 // triple products decided exactly (Gregorius, "The separating axis test
@@ -181,12 +186,34 @@ bool searchFaceAxes(const Prepared& a, const Prepared& b, double d0, double hyst
 	if (!likelyFace(a, b, towardsB) || !likelyFace(b, a, -towardsB)) return false;
 	faces.clear();
 	// An internal face still rejects (its plane separates), but is no entrance.
+	// Nor is a face of one block that faces an internal face of the other
+	// (opposed normals within kFacingInternalCosine): it can separate the
+	// pair only from the far side of that internal face's plane, where the
+	// flush neighbour covering the face (a fixed block, or another part of
+	// the same concave block) stands between them and its own pair holds the
+	// block. Taken as the entrance, its sub-contacts measured the other's
+	// seam corners and edges across it: a cube sliding over the seam of a
+	// free two-part slab met the seam edge as a step (1.1e5 N, its speed
+	// 1.0 -> 0.34 m/s; tests/py/blocks/test_concave_blocks.py). The rule only
+	// leaves contacts out (no force, no work); the face still rejects.
+	const auto facesInternal = [&](const Prepared& owner, int f, const Prepared& other) {
+		if (!other.internalFaces) return false;
+		ensurePlane(owner, f);
+		for (int g = 0; g < other.faceCount(); ++g) {
+			if (!other.internal(g)) continue;
+			ensurePlane(other, g);
+			if (owner.faces[f].normal.dot(other.faces[g].normal) <
+			    -kFacingInternalCosine * owner.faces[f].normal.norm() * other.faces[g].normal.norm())
+				return true;
+		}
+		return false;
+	};
 	const auto faceAxes = [&](const Prepared& owner, const Prepared& other, EntranceFeature::Kind kind) {
 		for (int f : owner.faceList) {
 			const double sep = faceSeparation(owner, f, other, known - hysteresis);
 			if (sep > d0) return false;
 			axes.deepestBound = std::max(axes.deepestBound, sep);
-			if (owner.internal(f)) continue;
+			if (owner.internal(f) || facesInternal(owner, f, other)) continue;
 			faces.push_back({{kind, f, -1}, sep});
 			known = std::max(known, sep);
 		}

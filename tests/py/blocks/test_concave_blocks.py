@@ -139,6 +139,57 @@ def test_a_cube_in_the_inner_corner_rests_on_the_foot(scene):
     assert abs(account(end) - account(start)) < 1e-3 * max(abs(end[k] - start[k]) for k in end)
 
 
+@pytest.mark.parametrize('rigid', [True, False])
+def test_an_l_slides_down_a_slope_at_the_closed_form_rate(scene, rigid):
+    """The L of three cubes lying flat on a level floor, gravity tilted 30 degrees (a slope), joint friction
+    20 degrees: it slides at a = g (sin 30 - tan 20 cos 30) (1 %), its seams (corners of two parts at one
+    place, faces the parts share) adding no force: no rotation (1e-6 rad/s) and no sideways drift. The
+    energy account balances."""
+    rock = material(O, young=1e9, frictionDeg=20)
+    O.bodies.append(ddaBlock(box((-2, -2, -1), (12, 4, 0)), material=rock, fixed=True))
+    clumpId, members = O.bodies.appendClumped(concaveBlock(l_parts(), material=rock, rigid=rigid))
+    theta = math.radians(30)
+    O.engines = [DDAIntegrator(dt=1e-3, gravity=(G * math.sin(theta), 0, -G * math.cos(theta)))]
+    O.run(50, True)
+    start = yade_dda.stats()['energy']
+    t0, x0, v0 = O.time, O.bodies[clumpId].state.pos[0], O.bodies[clumpId].state.vel[0]
+    y0 = O.bodies[clumpId].state.pos[1]
+    O.run(400, True)
+    t = O.time - t0
+    x = O.bodies[clumpId].state.pos[0]
+    a = 2 * (x - x0 - v0 * t) / t ** 2
+    expected = G * (math.sin(theta) - math.tan(math.radians(20)) * math.cos(theta))
+    print('rigid %s: a = %.5f m/s^2, closed form %.5f' % (rigid, a, expected))
+    assert a == pytest.approx(expected, rel=0.01)
+    assert abs(O.bodies[clumpId].state.pos[1] - y0) < 1e-6
+    assert max(abs(w) for w in O.bodies[clumpId].state.angVel) < 1e-6
+    end = yade_dda.stats()['energy']
+    account = lambda e: (e['kinetic'] + e['gravity'] + e['strain'] + e['contact'] + e['friction'] + e['damping']
+                         - e['loads'] - e['contactChanges'])
+    assert abs(account(end) - account(start)) < 1e-3 * max(abs(end[k] - start[k]) for k in end)
+
+
+def test_a_cube_slides_across_the_seam_of_a_concave_slab_without_feeling_it(scene):
+    """A free slab of two parts side by side (its seam, a face the parts share, across the path) lying on
+    a floor, and a 0.5 m cube sliding over it at 1 m/s, frictionless, under gravity: crossing the seam
+    neither slows the cube (its speed kept to 1e-3) nor pushes the slab (1e-3 m/s), and no contact is
+    ever made on the shared face (every closed contact of the cube is on the slab's top faces, normal z)."""
+    rock = material(O, young=1e9, frictionDeg=0)
+    O.bodies.append(ddaBlock(box((-3, -2, -1), (7, 3, 0)), material=rock, fixed=True))
+    clumpId, members = O.bodies.appendClumped(concaveBlock([box((0, 0, 0), (2, 1, 0.5)), box((2, 0, 0), (4, 1, 0.5))],
+                                                           material=rock))
+    c = O.bodies.append(ddaBlock(box((1.0, 0.25, 0.5), (1.5, 0.75, 1.0)), material=rock, velocity=(1, 0, 0)))
+    O.engines = [DDAIntegrator(dt=1e-3, gravity=(0, 0, -G), newmarkGamma=0.5, newmarkBeta=0.25)]
+    while O.bodies[c].state.pos[0] < 3.0:
+        O.step()
+        for contact in yade_dda.contacts('closed'):
+            if c in (contact.id1, contact.id2):
+                assert abs(contact.normal[2]) > 1 - 1e-6, contact
+        assert O.time < 3
+    assert O.bodies[c].state.vel[0] == pytest.approx(1.0, abs=1e-3)
+    assert abs(O.bodies[clumpId].state.vel[0]) < 1e-3
+
+
 def test_a_concave_scene_continues_bitwise_after_save_and_load(scene, tmp_path):
     corner_scene()
     O.run(100, True)
