@@ -8,7 +8,9 @@ and after the cut are both recorded. The cut is timed three times (wall clock of
 the core's phases from rock.stats), the first run's memory kept; the three must give bitwise the same
 blocks. For the 2 m case the time to make the YADE bodies (rock.ddaBlocks, O.bodies.append) is measured
 too. Writes bench/out/rock_mass.json; prints a table.
-Run: /usr/bin/python3 bench/rock_mass.py [--cases 8k,50k,8k-stochastic]
+The concave cases cut with concave=True (the first set at persistence 0.7, joined where absent) and time
+the join in the wall clock; '8k-concave' also times rock.append (bodies and clumps).
+Run: /usr/bin/python3 bench/rock_mass.py [--cases 8k,50k,8k-stochastic,8k-concave,50k-concave]
 """
 import argparse
 import json
@@ -25,6 +27,9 @@ CASES = {
     '8k': dict(spacing=2.0, stochastic=False, bodies=True),
     '50k': dict(spacing=1.09, stochastic=False, bodies=False),
     '8k-stochastic': dict(spacing=2.0, stochastic=True, bodies=False),
+    # cutRockMass(..., concave=True) with the first set at persistence 0.7: joined blocks (3DEC's model)
+    '8k-concave': dict(spacing=2.0, stochastic=False, bodies=True, concave=0.7),
+    '50k-concave': dict(spacing=1.09, stochastic=False, bodies=False, concave=0.7),
 }
 
 
@@ -36,10 +41,12 @@ def vmhwmMB():
     return float('nan')
 
 
-def jointSets(spacing, stochastic):
+def jointSets(spacing, stochastic, persistence=None):
     sets = [dict(dip=d, dipDirection=a, spacing=spacing, origin=ORIGIN) for d, a in ORIENTATIONS]
     if stochastic:
         sets[0].update(persistence=0.7, fisherK=30, spacingDistribution='exponential')
+    if persistence is not None:
+        sets[0].update(persistence=persistence)
     return sets
 
 
@@ -55,12 +62,13 @@ def runCase(name):
     from yade import wrapper
     baseline = vmhwmMB()
     domain = [(x, y, z) for x in (0, SIDE) for y in (0, SIDE) for z in (0, SIDE)]
-    sets = jointSets(case['spacing'], case['stochastic'])
+    concave = 'concave' in case
+    sets = jointSets(case['spacing'], case['stochastic'], case.get('concave'))
     walls, prints, rock = [], set(), None
     for run in range(3):
         rock = None
         start = time.perf_counter()
-        rock = cutRockMass(domain, sets, seed=1)
+        rock = cutRockMass(domain, sets, seed=1, concave=concave)
         walls.append(time.perf_counter() - start)
         prints.add(fingerprint(rock))
         if run == 0:
@@ -74,12 +82,16 @@ def runCase(name):
                volumeError=abs(sum(b.volume for b in rock.blocks) + sum(b.volume for b in rock.slivers)
                                - rock.domainVolume) / rock.domainVolume,
                wallSeconds=walls, wallSecondsMin=min(walls), coreSeconds=rock.stats['seconds'],
-               bitwiseRepeatable=len(prints) == 1,
+               bitwiseRepeatable=len(prints) == 1, concave=concave,
+               concaveBlocks=sum(len(g) > 1 for g in rock.groups), ddaBlocks=len(rock.groups),
                vmhwmBaselineMB=baseline, vmhwmAfterCutMB=peak, cutPeakIncreaseMB=peak - baseline)
     if case['bodies']:
         mat = O.materials.append(wrapper.PolyhedraMat(young=1e9, poisson=0.25, density=2600))
         start = time.perf_counter()
-        O.bodies.append(rock.ddaBlocks(material=mat))
+        if concave:
+            rock.append(material=mat)
+        else:
+            O.bodies.append(rock.ddaBlocks(material=mat))
         out['bodiesSeconds'] = time.perf_counter() - start
         out['vmhwmAfterBodiesMB'] = vmhwmMB()
     return out
@@ -102,11 +114,12 @@ def main():
     os.makedirs(os.path.dirname(args.out), exist_ok=True)
     with open(args.out, 'w') as f:
         json.dump(dict(benchmark='rock_mass', rows=rows), f, indent=1)
-    print('%-14s %8s %7s %7s %9s %9s %9s %10s %10s' % ('case', 'blocks', 'merged', 'slivers', 'wall [s]', 'core cut',
-                                                     'slivers', 'peak+ [MB]', 'bodies [s]'))
+    print('%-14s %8s %8s %7s %7s %9s %9s %9s %10s %10s' % ('case', 'blocks', 'concave', 'merged', 'slivers', 'wall [s]',
+                                                          'core cut', 'slivers', 'peak+ [MB]', 'bodies [s]'))
     for r in rows:
-        print('%-14s %8d %7d %7d %9.2f %9.3f %9.3f %10.0f %10s' % (
-            r['case'], r['blocks'], r['merged'], r['slivers'], r['wallSecondsMin'], r['coreSeconds']['cut'],
+        print('%-14s %8d %8d %7d %7d %9.2f %9.3f %9.3f %10.0f %10s' % (
+            r['case'], r['blocks'], r['concaveBlocks'], r['merged'], r['slivers'], r['wallSecondsMin'],
+            r['coreSeconds']['cut'],
             r['coreSeconds']['slivers'], r['cutPeakIncreaseMB'],
             '%.1f' % r['bodiesSeconds'] if 'bodiesSeconds' in r else '-'))
     print('wrote', args.out)

@@ -4,7 +4,7 @@
 # wedge above both joints is free, the rest fixed. The joints' friction angle is chosen for the factor
 # of safety FS (argument, default 0.7); the script prints FS and the wedge's motion along the line of
 # intersection against a = g sin(psi) (1 - FS).
-# Run with: yade -n -x examples/wedge.py [FS]   (or /usr/bin/python3 examples/wedge.py [FS])
+# Run with: yade -n -x examples/wedge.py [FS] [--vtk=DIR]   (or /usr/bin/python3 examples/wedge.py [FS])
 # tests/py/system/test_wedge.py is the test; doc/rock-mass.md reports the numbers.
 import math
 import sys
@@ -15,7 +15,9 @@ from yade_dda import *
 from yade import PolyhedraMat
 
 G = 9.81
-FS = float(sys.argv[1]) if len(sys.argv) > 1 else 0.7
+ARGS = [a for a in sys.argv[1:] if not a.startswith('--vtk')]
+VTK = next((a.split('=', 1)[1] for a in sys.argv[1:] if a.startswith('--vtk=')), '')
+FS = float(ARGS[0]) if ARGS else 0.7
 SLOPE, HEIGHT, LENGTH, WIDTH = 65.0, 10.0, 20.0, 20.0
 
 
@@ -49,6 +51,9 @@ start = np.array(block(wedge).centroid)
 print('wedge: %.2f m^3, %.0f kg' % (block(wedge).volume, block(wedge).mass))
 
 O.engines = [DDAIntegrator(dt=1e-3, gravity=(0, 0, -G), maxDisplacement=0.01, label='dda')]
+if VTK:   # --vtk=DIR: ParaView output every 0.1 s (doc/wedge.png: tools/render_vtk.py DIR/wedge-)
+    import os
+    O.engines = O.engines + [DDAVTKRecorder(fileName=os.path.join(VTK, 'wedge-'), virtPeriod=0.1)]
 expected = G * math.sin(psi) * (1 - FS) if FS < 1 else 0.0
 for _ in range(5):
     O.run(100, True)
@@ -56,3 +61,6 @@ for _ in range(5):
     along = d @ s
     print('t %.2f s: %.5f m along s (closed form %.5f m), %.2e m across, speed %.4f m/s'
           % (O.time, along, expected * O.time ** 2 / 2, np.linalg.norm(d - along * s), np.linalg.norm(block(wedge).velocity[:3])))
+if VTK:
+    from yade_dda.recorder import record
+    record(os.path.join(VTK, 'wedge-'))     # the final state too
