@@ -123,6 +123,11 @@ int SceneLink::blockOfBody(int bodyId) const {
 	return found == blockOfBody_.end() ? -1 : world.bodyOf(found->second);
 }
 
+int SceneLink::partOfBody(int bodyId) const {
+	const auto found = blockOfBody_.find(bodyId);
+	return found == blockOfBody_.end() ? -1 : found->second;
+}
+
 void SceneLink::linkClump(int block, int clumpId, const Eigen::Quaterniond& orientation0) {
 	if (world.block(block).partCount < 2) {
 		std::ostringstream message;

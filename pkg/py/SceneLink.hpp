@@ -65,6 +65,8 @@ public:
 	// The block a body shows: the block itself, or for a member or the clump
 	// of a concave block its body (World::bodyOf); -1 for other bodies.
 	int blockOfBody(int bodyId) const;
+	// The block a body is linked to itself: a member's part (not its body), a clump's body; -1 for others.
+	int partOfBody(int bodyId) const;
 	Eigen::Quaterniond bodyOrientation(int block) const;
 	Eigen::Quaterniond clumpOrientation(int block) const;
 	// Where YADE's body of a block sits [m]: the block's centroid, or for a

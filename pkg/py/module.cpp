@@ -461,6 +461,10 @@ void registerConcaveBlocks(py::class_<SceneLink, boost::noncopyable>& scene) {
 	         "The YADE clump body that shows concave block `block` (its body's index), with its ori at creation.")
 	    .def("parts", &blockParts, "The corners [m] of each convex part of block i (one list for a convex block).")
 	    .def("partCount", +[](const SceneLink& s, int i) { return s.world.block(i).partCount; })
+	    .def("partOfBody", +[](const SceneLink& s, int bodyId) {
+		    const int part = s.partOfBody(bodyId);
+		    return part < 0 ? py::object() : py::object(part);
+	    }, "The block a body is linked to itself (a member's part), or None.")
 	    .def("bodyOf", +[](const SceneLink& s, int i) { s.world.block(i); return s.world.bodyOf(i); },
 	         "The block whose unknowns block i moves with (a concave block's body for its parts).")
 	    .def("partPosition", +[](const SceneLink& s, int i) { return s.partPosition(i); },

@@ -505,14 +505,17 @@ class Ig2_DDABlock_DDABlock_DDAContact:
     (id1 owns the vertex or first edge), ``feature1``/``feature2`` (vertex,
     face or edge indices as in ``block(body).faces``/``.edges``), ``gap`` [m],
     ``normal`` (from id2 towards id1), ``point1``/``point2`` [m].
-    The integrator runs the same functor every step. Example::
+    The integrator runs the same functor every step. For a concave block give
+    the members' ids (each its part); the clump's id stands for its first part. Example::
 
         print(Ig2_DDABlock_DDABlock_DDAContact().go(b1, b2, 0.01))
     """
 
     def go(self, body1, body2, contactDistance=0.0):
         scene = _require()
-        i, j = scene.blockIndex(body1), scene.blockIndex(body2)
+        # A concave block's member: its own part (the clump stands for its first part).
+        scene.blockIndex(body1), scene.blockIndex(body2)   # KeyError for a body that is no DDA block
+        i, j = scene.core.partOfBody(_bodyId(body1)), scene.core.partOfBody(_bodyId(body2))
         try:
             contactDistance = float(contactDistance)
         except (TypeError, ValueError):

@@ -132,6 +132,9 @@ def test_a_cube_in_the_inner_corner_rests_on_the_foot(scene):
     pairs = {(i.id1, i.id2) for i in O.interactions if i.isReal}
     assert (min(c, foot), max(c, foot)) in pairs
     assert all(c not in p or foot in p for p in pairs), pairs
+    # The narrow phase as a functor on the members: the foot touches the cube, the wall's part does not.
+    functor = yade_dda.Ig2_DDABlock_DDABlock_DDAContact()
+    assert functor.go(foot, c, 0.01)['contacts'] and functor.go(members[2], c, 1e-4) is None
     assert abs(O.bodies[c].state.pos[2] - 1.25) < 2e-4
     end = yade_dda.stats()['energy']
     account = lambda e: (e['kinetic'] + e['gravity'] + e['strain'] + e['contact'] + e['friction'] + e['damping']
