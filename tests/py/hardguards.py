@@ -129,21 +129,32 @@ class Guard:
         self.extraPenetration = extraPenetration
         self.maxCutsPerStep = maxCutsPerStep
         self.maxCutFraction = maxCutFraction
+        # A concave block enters as its members: each member's geometry is its own part's (`shapes`), its
+        # state the block's (`views`, shared by the members; its energy counted once, by `owner`).
+        scene = yade_dda.scene.current(create=False)
+        part = {b: scene.core.partOfBody(b) for b in self.bodies}
+        self.owner = {b: scene.core.bodyOf(part[b]) for b in self.bodies}
+        self.shapes = {b: yade_dda.scene.BlockView(scene, part[b]) for b in self.bodies}
         self.views = {b: yade_dda.block(b) for b in self.bodies}
         self.info = {}
         for b, blk in self.views.items():
             mat = O.bodies[b].material
+            shape = self.shapes[b]
             self.info[b] = dict(fixed=blk.fixed, young=mat.young, size=blk.volume ** (1.0 / 3.0),
                                 compliance=compliance(mat.young, mat.poisson),
-                                topology=Topology([tuple(f) for f in blk.faces], [tuple(e) for e in blk.edges]))
+                                topology=Topology([tuple(f) for f in shape.faces], [tuple(e) for e in shape.edges]))
         self.moving = [b for b in self.bodies if not self.info[b]['fixed']]
+        first = {}
+        for b in self.moving:
+            first.setdefault(self.owner[b], b)
+        self.movingBlocks = list(first.values())   # one member per moving DDA block
         if pairs is None:
             pairs = [(a, b) for i, a in enumerate(self.bodies) for b in self.bodies[i + 1:]
-                     if not (self.info[a]['fixed'] and self.info[b]['fixed'])]
+                     if not (self.info[a]['fixed'] and self.info[b]['fixed']) and self.owner[a] != self.owner[b]]
         self.pairs = list(pairs)
         self.fixedCorners = {b: self.corners(b) for b in self.bodies if self.info[b]['fixed']}
         self.integrator = O.engines[-1]
-        self.mass = sum(self.views[b].mass for b in self.moving)
+        self.mass = sum(self.views[b].mass for b in self.movingBlocks)
         self.size = max(self.info[b]['size'] for b in self.bodies)
         self.kn = self.integrator.contactPenaltyFactor * min(self.info[b]['young'] * self.info[b]['size']
                                                              for b in self.bodies)
@@ -156,12 +167,12 @@ class Guard:
         self.kineticMax = parts['kinetic']
 
     def corners(self, b):
-        return numpy.array([tuple(v) for v in self.views[b].vertices])
+        return numpy.array([tuple(v) for v in self.shapes[b].vertices])
 
     def energy(self, parts=False):
         """Total mechanical energy [J] (see the module docstring); `parts` gives the terms."""
         kinetic = gravity = strain = springs = 0.0
-        for b in self.moving:
+        for b in self.movingBlocks:
             blk = self.views[b]
             mass, volume = blk.mass, blk.volume
             kinetic += S.kinetic_energy(mass, volume, blk.secondMoment, blk.velocity)

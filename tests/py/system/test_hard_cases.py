@@ -627,6 +627,50 @@ def test_resting_stack_for_20000_steps(scene, tiltDeg):
     assert kinetic < 1e-9 * guard.mass * G * 1.0
 
 
+def cubes(offsets, size=1.0):
+    """Corner lists of cubes of side `size` at the grid offsets (in units of `size`), centred on the origin."""
+    h = size / 2
+    return [S.box((o[0] * size - h, o[1] * size - h, o[2] * size - h), (o[0] * size + h, o[1] * size + h, o[2] * size + h))
+            for o in offsets]
+
+
+def moved(parts, axis, angle, by):
+    return [shifted(rotate(part, axis, angle), by) for part in parts]
+
+
+@pytest.mark.parametrize('drop', ['corner', 'seam'])
+def test_concave_blocks_dropped_into_a_concave_corner(scene, drop):
+    """Concave blocks in hard contact: a fixed L of three 1 m cubes (a step: foot and wall) on a floor,
+    a T of four cubes dropped turned into the L's inner corner, a rigid L dropped corner first onto the
+    T, friction 30 deg; 'seam': the T dropped flat across the fixed L's seams instead. 0.5 s.
+
+    What could go wrong: a corner or edge meets the seam between two parts of a block (the faces they
+    share) and finds a contact on a face inside the block; two parts of one block contact each other;
+    the parts of a moving block move apart; the union's mass properties and the energy of several
+    parts are counted twice. The guards check the true overlap of every part of one block with every
+    part of the others (not of its own), and the energy of each block once.
+    """
+    def build():
+        floor(0.0, frictionDeg=30)
+        ids = []
+        clump, members = O.bodies.appendClumped(yade_dda.concaveBlock(
+            cubes([(0, 0, 0), (1, 0, 0), (0, 0, 1)]), material=rock(30), fixed=True))
+        t = [(0, 0, 0), (1, 0, 0), (-1, 0, 0), (0, 1, 0)]
+        if drop == 'corner':
+            T = moved(cubes(t, 0.5), (1, 1, 0), 0.4, (1.4, 0.1, 1.9))
+        else:
+            T = moved(cubes(t, 0.5), (0, 0, 1), 0.3, (0.6, 0.2, 2.3))
+        ids.append(O.bodies.appendClumped(yade_dda.concaveBlock(T, material=rock(30)))[0])
+        L = moved(cubes([(0, 0, 0), (1, 0, 0), (0, 1, 0)], 0.4), (1, -1, 0.5), 0.9, (1.2, 0.3, 3.2))
+        ids.append(O.bodies.appendClumped(yade_dda.concaveBlock(L, material=rock(30), rigid=True))[0])
+        return ids
+
+    guard, blocks = run_case(build, 500)
+    assert guard.worstPenetration > 0   # they did land
+    for b in blocks:
+        assert yade_dda.block(b).partCount > 1
+
+
 @pytest.mark.slow
 def test_threads_do_not_change_a_hard_field(scene):
     """Determinism with threads engaged: 1100 hard placements side by side on one floor, 1375 moving
