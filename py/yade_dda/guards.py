@@ -111,7 +111,7 @@ def checkYadeContacts(scene, engines):
     loops = [type(e).__name__ for e in engines if _handlesPolyhedra(e)]
     if not loops or not scene.bodyOfBlock:
         return
-    blockIds = set(scene.bodyOfBlock)
+    blockIds = set(scene.bodyOfBlock) | set(scene.clumpMembers)   # a concave block's clump is no YADE body
     bodies = O.bodies
     ddaMask, firstBlock = 0, {}
     for bodyId in scene.bodyOfBlock:
