@@ -247,17 +247,23 @@ def collected(nodeids):
 
 
 def list_mutations(chosen):
-    """Prints each mutation's tests, marking those pytest does not collect; True when all are."""
+    """Prints each mutation's tests, marking those pytest does not collect, and the patches that no longer
+    apply to this checkout (`git apply --check`: their target moved); True when all are collected and apply."""
     nodeids = {t for m in chosen for t in m['tests']}
     found = collected(nodeids)
+    stale = 0
     for m in chosen:
-        print('%s: %s' % (m['name'], m['removes']))
+        applies = subprocess.run(['git', 'apply', '--check', m['path']], cwd=REPO, stdout=subprocess.DEVNULL,
+                                 stderr=subprocess.DEVNULL).returncode == 0
+        stale += not applies
+        print('%s: %s%s' % (m['name'], m['removes'], '' if applies else '   <- DOES NOT APPLY'))
         for t in m['tests']:
             print('  %s%s' % (t, '' if t in found else '   <- NOT COLLECTED'))
     missing = len(nodeids - found)
-    print('\n%d tests named by %d mutations; %s' % (
-        len(nodeids), len(chosen), 'all collected' if not missing else '%d NOT collected' % missing))
-    return not missing
+    print('\n%d tests named by %d mutations; %s; %s' % (
+        len(nodeids), len(chosen), 'all collected' if not missing else '%d NOT collected' % missing,
+        'every patch applies' if not stale else '%d patches DO NOT APPLY' % stale))
+    return not missing and not stale
 
 
 def first_line(message, width=None):
