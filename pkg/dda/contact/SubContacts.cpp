@@ -301,9 +301,10 @@ void faceEntranceContacts(const Prepared& owner, bool ownerIsA, int f, const Pre
 	std::vector<char>& ready = s.cornerDistanceReady;
 	distances.resize(other.cornerCount());
 	ready.assign(other.cornerCount(), 0);
+	const double bound = planeRoundoffBound(owner, f, other.lower, other.upper);
 	const auto distance = [&](int v) {
 		if (!ready[v]) {
-			distances[v] = planeDistance(owner, f, other.corner(v));
+			distances[v] = planeDistanceInBox(owner, f, other.corner(v), bound);
 			ready[v] = 1;
 			++*owner.tests;
 		}
