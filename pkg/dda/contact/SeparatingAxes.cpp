@@ -17,9 +17,11 @@ namespace {
 // of A, so searchEdgeAxes computes each once per (edge, face of the other
 // block) instead of per edge pair (signOfTriple below, the same expression
 // and the same exact fallback as unitOrientation).
+inline int filteredSign(double approx) {
+	return (approx > kUnitTripleRoundoff) - (approx < -kUnitTripleRoundoff);  // 0: not settled
+}
 inline int signOfTriple(const Vector3& x, const Vector3& y, const Vector3& z, const Vector3& yz) {
-	const double approx = x.dot(yz);  // x . (y x z), yz = y x z
-	const int sign = (approx > kUnitTripleRoundoff) - (approx < -kUnitTripleRoundoff);
+	const int sign = filteredSign(x.dot(yz));  // x . (y x z), yz = y x z
 	return sign != 0 ? sign : unitOrientationExact(x, y, z);
 }
 
@@ -240,8 +242,12 @@ bool searchEdgeAxes(const Prepared& a, const Prepared& b, double d0, double sinT
 		int* row = faceSigns.data() + static_cast<std::size_t>(faceRow[f]) * usable;
 		for (int k = 0; k < usable; ++k) {
 			const std::array<int, 3>& edge = bEdges[k];
-			const Vector3 C = -b.faces[edge[1]].normal, D = -b.faces[edge[2]].normal;
-			row[k] = signOfTriple(normal, D, C, b.edges[edge[0]].arc);  // (-D) x (-C) = D x C
+			int sign = filteredSign(normal.dot(b.edges[edge[0]].arc));  // (-D) x (-C) = D x C
+			if (sign == 0) {
+				const Vector3 C = -b.faces[edge[1]].normal, D = -b.faces[edge[2]].normal;
+				sign = unitOrientationExact(normal, D, C);
+			}
+			row[k] = sign;
 		}
 	}
 	for (int ea : a.edgeList) {

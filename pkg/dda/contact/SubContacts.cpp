@@ -154,16 +154,20 @@ std::optional<SubContact> edgeEdgeContact(bool firstIsA, const Prepared& blockI,
 	// (lengthTolerance > 0). The same pairs are rejected, only sooner.
 	// Every test below only rejects, so their order changes no result.
 	const Vector3 w = p3 - p1;
-	const double sNumerator = w.cross(db).dot(cross), tNumerator = w.cross(da).dot(cross);
+	const double sNumerator = w.cross(db).dot(cross);
+	double tNumerator;
 	{
 		// First without a square root: sLine = sNumerator / nn with nn > 0
 		// (nn = 0 gives no rejection here), so a negative numerator gives a
 		// negative sLine, or -0 for an underflow, which the endpoint test
 		// rejects; and nn is cross.squaredNorm() to within a few DBL_EPSILON
 		// (|cross| rounded, then squared), so a numerator above
-		// (1 + 1e-12) squaredNorm gives sLine > 1.
+		// (1 + 1e-12) squaredNorm gives sLine > 1. s's test before t's
+		// numerator is computed (the tests only reject).
 		const double bound = (1 + 1e-12) * cross.squaredNorm();
-		if (sNumerator < 0 || tNumerator < 0 || sNumerator > bound || tNumerator > bound) return std::nullopt;
+		if (sNumerator < 0 || sNumerator > bound) return std::nullopt;
+		tNumerator = w.cross(da).dot(cross);
+		if (tNumerator < 0 || tNumerator > bound) return std::nullopt;
 	}
 	const double la = da.norm(), lb = db.norm();
 	const double crossNorm = cross.norm();
