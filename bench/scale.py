@@ -14,7 +14,9 @@ One table per size n (1,000, 10,000, 50,000 blocks; bench/colliders.py's seeded 
 Writes bench/out/scale.json (everything, with each target's verdict) and scale_steps.png (time per
 step against blocks, log-log, n log n drawn), and prints the table. Long: about half an hour with
 50,000 blocks (YADE's step alone takes seconds there). Run: make bench-scale, or
-/usr/bin/python3 bench/scale.py [--sizes 1000,10000] (YADE_DDA_BUILD=<build>/py for a build tree).
+/usr/bin/python3 bench/scale.py [--sizes 1000,10000] (YADE_DDA_BUILD=<build>/py for a build tree);
+--detection-only gives the detection columns alone (with the narrow phase's cost per candidate pair), all
+on one thread, in a few minutes.
 """
 import argparse
 import json
@@ -115,7 +117,8 @@ def _detection(collidersResult, n):
             mean = summary['mean']
             out[summary['strategy']] = dict(detectionMs=mean['detectionMs'], peakMB=summary['peakMB'],
                                             candidatePairs=mean.get('candidatePairs'),
-                                            contactPairs=mean.get('contactPairs'), wallMs=mean.get('wallMs'))
+                                            contactPairs=mean.get('contactPairs'), wallMs=mean.get('wallMs'),
+                                            broadMs=mean.get('broadMs'), narrowMs=mean.get('narrowMs'))
     return out
 
 
@@ -133,6 +136,33 @@ def table(rows, drop):
         lines.append('')
         lines.append("70-block hexahedra drop, piled up: %.0f steps/s on 1 thread, %.0f on 2 (%d contact pairs)"
                      % (drop['stepsPerSecond']['1'], drop['stepsPerSecond']['2'], drop['contactPairs']))
+    return '\n'.join(lines)
+
+
+def detectionRow(n, det):
+    """Issue 21's detection columns for n blocks from _detection's strategies."""
+    msc, dess, yade = det.get('MSC', {}), det.get('DESS', {}), det.get('InsertionSortCollider', {})
+    return dict(
+        blocks=n, mscDetectionMs=msc.get('detectionMs'), dessDetectionMs=dess.get('detectionMs'),
+        yadeDetectionMs=yade.get('detectionMs'),
+        mscOverYade=msc['detectionMs'] / yade['detectionMs'] if yade.get('detectionMs') else None,
+        mscOverDess=msc['detectionMs'] / dess['detectionMs'],
+        candidatesOverPairs=msc['candidatePairs'] / msc['contactPairs'],
+        mscBroadMs=msc.get('broadMs'), mscNarrowMs=msc.get('narrowMs'),
+        # The narrow phase's cost per candidate pair [us] (its planes, the pair tests, the contacts' set-up).
+        mscNarrowUsPerCandidate=1e3 * msc['narrowMs'] / msc['candidatePairs'] if msc.get('narrowMs') else None,
+        mbPerBlock=msc['peakMB'] / n)
+
+
+def detectionTable(rows):
+    lines = ['| blocks | MSC detection | of which narrow | narrow per candidate | YADE ISC + polyhedra | MSC/YADE | '
+             'MSC/DESS | MSC candidates / pairs |', '|---|---|---|---|---|---|---|---|']
+    for r in rows:
+        lines.append('| %d | %.1f ms | %.1f ms | %.2f us | %s | %s | %.2f | %.2f |' % (
+            r['blocks'], r['mscDetectionMs'], r['mscNarrowMs'], r['mscNarrowUsPerCandidate'],
+            '%.0f ms' % r['yadeDetectionMs'] if r['yadeDetectionMs'] else 'n/a',
+            '%.3f (1/%.1f)' % (r['mscOverYade'], 1 / r['mscOverYade']) if r['mscOverYade'] else 'n/a',
+            r['mscOverDess'], r['candidatesOverPairs']))
     return '\n'.join(lines)
 
 
@@ -167,6 +197,8 @@ def main():
     parser.add_argument('--drop-rounds', type=int, default=3)
     parser.add_argument('--drop-steps', type=int, default=300)
     parser.add_argument('--no-yade', action='store_true', help="skip YADE's collider (its 50,000-block steps take seconds)")
+    parser.add_argument('--detection-only', action='store_true',
+                        help='only the detection columns (one thread each): no full steps, no 2-thread rounds, no drop')
     parser.add_argument('--out', default=os.path.join(HERE, 'out', 'scale.json'))
     parser.add_argument('--worker', nargs='*', help=argparse.SUPPRESS)
     args = parser.parse_args()
@@ -189,22 +221,33 @@ def main():
                     '--strategies', strategies, '--seed', str(args.seed), '--out', collidersOut], check=True)
     with open(collidersOut) as f:
         collidersResult = json.load(f)
+    if args.detection_only:
+        rows = [detectionRow(n, _detection(collidersResult, n)) for n in sizes]
+        verdicts = dict(mscOverYade={str(r['blocks']): r['mscOverYade'] <= TARGETS['mscOverYade'] for r in rows
+                                     if r['mscOverYade']},
+                        candidatesOverPairs={str(r['blocks']): r['candidatesOverPairs'] <= TARGETS['candidatesOverPairs']
+                                             for r in rows})
+        result = dict(benchmark='scale (issue 21), detection only', machine=colliders.machine(), seed=args.seed,
+                      sizes=sizes, targets=TARGETS, verdicts=verdicts, rows=rows, seconds=time.time() - started,
+                      detectionFrom=os.path.basename(collidersOut),
+                      how='bench/colliders.py children, one thread each, means over the steps after the first')
+        with open(args.out, 'w') as f:
+            json.dump(result, f, indent=1)
+        print(detectionTable(rows))
+        print('verdicts:', json.dumps(verdicts))
+        print('wrote', args.out)
+        return
     rows = []
     for n in sizes:
         print('threads: %d blocks ...' % n, flush=True)
         steps = _child(['--worker', 'threads', str(n), '--seed', str(args.seed), '--rounds', str(args.rounds),
                         '--out', args.out])
-        det = _detection(collidersResult, n)
-        msc, dess, yade = det.get('MSC', {}), det.get('DESS', {}), det.get('InsertionSortCollider', {})
         one, two = steps['1'], steps['2']
-        rows.append(dict(
-            blocks=n, mscDetectionMs=msc.get('detectionMs'), dessDetectionMs=dess.get('detectionMs'),
-            yadeDetectionMs=yade.get('detectionMs'),
-            mscOverYade=msc['detectionMs'] / yade['detectionMs'] if yade.get('detectionMs') else None,
-            mscOverDess=msc['detectionMs'] / dess['detectionMs'],
-            candidatesOverPairs=msc['candidatePairs'] / msc['contactPairs'],
-            step1Ms=one['stepMs'], step2Ms=two['stepMs'], syncMs=one['syncMs'], syncShare=one['syncMs'] / one['stepMs'],
-            twoThreadRatio=two['stepMs'] / one['stepMs'], mbPerBlock=msc['peakMB'] / n, oneThread=one, twoThreads=two))
+        row = detectionRow(n, _detection(collidersResult, n))
+        row.update(step1Ms=one['stepMs'], step2Ms=two['stepMs'], syncMs=one['syncMs'],
+                   syncShare=one['syncMs'] / one['stepMs'], twoThreadRatio=two['stepMs'] / one['stepMs'],
+                   oneThread=one, twoThreads=two)
+        rows.append(row)
     print('drop ...', flush=True)
     drop = _child(['--worker', 'drop', '--drop-rounds', str(args.drop_rounds), '--drop-steps', str(args.drop_steps),
                    '--out', args.out])

@@ -10,6 +10,7 @@
 #include "PairDetection.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -46,6 +47,10 @@ struct Scratch {
 	std::vector<char> cornerDistanceReady;
 	std::vector<int> used, faceEdges;
 	std::vector<int> edgeFacesB, arcSides;  // the edge axes' Gauss-map test
+	std::vector<Vector3> inwardNormalsB;     // minus the normals of edgeFacesB, in its order
+	std::vector<std::array<int, 3>> edgesB;  // B's edges for edge axes: edge, its two faces
+	std::vector<int> crossingEdges;          // per edge of A: positions in edgesB whose arcs cross
+	std::vector<int> faceRows, faceSigns;    // per face of A: its row of Gauss-map signs per edge of B
 	std::vector<char> faceMark;
 	std::vector<Vector3> pointsA, pointsB;
 	std::vector<int> identity;  // 0, 1, 2, ...: "every sub-unit"
@@ -165,6 +170,34 @@ inline double planeDistance(const Prepared& block, int f, const Vector3& x) {
 	const double normBound = (std::abs(offset.x()) + std::abs(offset.y()) + std::abs(offset.z())) * (1 + 1e-6);
 	if (std::abs(d) > kRoundoffRelative * (normBound + plane.side1 + plane.side2)) return d;
 	return planeDistanceNearPlane(block, f, x, offset, d);
+}
+
+// A threshold for planeDistance's round-off test that holds for every point
+// in the box [lower, upper] [m] (the other block's corner box): the test's
+// own threshold, kRoundoffRelative (normBound + side1 + side2), with each
+// |offset| component replaced by the larger of the box's ends' (|fl(x - f0)|
+// <= max(|fl(lower - f0)|, |fl(upper - f0)|) since fl(. - f0) is monotone),
+// summed and scaled in the same order, each step monotone in floating point:
+// it is at least the threshold of any point of the box.
+inline double planeRoundoffBound(const Prepared& block, int f, const Vector3& lower, const Vector3& upper) {
+	const FacePlane& plane = block.faces[f];
+	const Vector3& f0 = block.corner(plane.corners[0]);
+	const auto larger = [&](int k) { return std::max(std::abs(lower(k) - f0(k)), std::abs(upper(k) - f0(k))); };
+	const double normBound = (larger(0) + larger(1) + larger(2)) * (1 + 1e-6);
+	return kRoundoffRelative * (normBound + plane.side1 + plane.side2);
+}
+
+// planeDistance for a point x of the box `bound` was computed for
+// (planeRoundoffBound): a |d| above that bound is above x's own threshold,
+// where planeDistance returns d (the same expressions); otherwise
+// planeDistance decides. The same double either way, with one comparison
+// per point instead of a norm bound.
+inline double planeDistanceInBox(const Prepared& block, int f, const Vector3& x, double bound) {
+	const FacePlane& plane = block.faces[f];
+	const Vector3 offset = x - block.corner(plane.corners[0]);
+	const double d = plane.normal.dot(offset);
+	if (std::abs(d) > bound) return d;
+	return planeDistance(block, f, x);
 }
 
 // Distance [m] of x from the segment pq.

@@ -11,35 +11,23 @@ namespace {
 // that little against a seam still lies on the neighbour's side of it.
 constexpr double kFacingInternalCosine = 0.99;
 
-// Do the Gauss-map arcs of edge ea of A (a1, a2 its faces' normals) and of
-// edge eb of B (c, d: minus its faces' normals) cross (strictly)? Signs of
-// triple products decided exactly (Gregorius, "The separating axis test
-// between convex polyhedra", GDC 2013).
-//
-// The first two signs depend on ea and on one face of B only: the caller
-// computes them once per (ea, face of B) with arcSide and passes
-// cba = arcSide(a, ea, b, fb[0]), dba = arcSide(a, ea, b, fb[1]) (the same
-// expressions the test evaluated per edge pair), having checked
-// cba * dba < 0.
-int arcSide(const Prepared& a, int ea, const Prepared& b, int g) {
-	const auto& fa = a.shape->edgeFaces[ea];
-	const Vector3& A = a.faces[fa[0]].normal;
-	const Vector3& B = a.faces[fa[1]].normal;
-	const Vector3 C = -b.faces[g].normal;
-	const Vector3& ba = a.edges[ea].arc;                // B x A
-	return unitOrientation(C.dot(ba), C, B, A);  // C . (B x A)
+// Do the Gauss-map arcs of edge ea of A (A, B its faces' outward normals)
+// and of edge eb of B (C, D: minus its faces' normals) cross (strictly)?
+// With A . (D x C) = adc, B . (D x C) = bdc, C . (B x A) = cba and
+// D . (B x A) = dba, exactly when cba dba < 0, adc bdc < 0 and cba bdc > 0
+// (Gregorius, "The separating axis test between convex polyhedra", GDC
+// 2013). Each sign is a triple product of unit normals decided exactly
+// (unitOrientation: a double filter, CGAL below its round-off bound). The
+// first two depend on ea and one face of B, the last two on eb and one face
+// of A, so searchEdgeAxes computes each once per (edge, face of the other
+// block) instead of per edge pair (signOfTriple below, the same expression
+// and the same exact fallback as unitOrientation).
+inline int filteredSign(double approx) {
+	return (approx > kUnitTripleRoundoff) - (approx < -kUnitTripleRoundoff);  // 0: not settled
 }
-
-bool arcsCross(const Prepared& a, int ea, const Prepared& b, int eb, int cba) {
-	const auto& fa = a.shape->edgeFaces[ea];
-	const auto& fb = b.shape->edgeFaces[eb];
-	const Vector3& A = a.faces[fa[0]].normal;
-	const Vector3& B = a.faces[fa[1]].normal;
-	const Vector3 C = -b.faces[fb[0]].normal, D = -b.faces[fb[1]].normal;
-	const Vector3& dc = b.edges[eb].arc;  // (-D) x (-C) = D x C
-	const int adc = unitOrientation(A.dot(dc), A, D, C);  // A . (D x C)
-	const int bdc = unitOrientation(B.dot(dc), B, D, C);
-	return adc * bdc < 0 && cba * bdc > 0;
+inline int signOfTriple(const Vector3& x, const Vector3& y, const Vector3& z, const Vector3& yz) {
+	const int sign = filteredSign(x.dot(yz));  // x . (y x z), yz = y x z
+	return sign != 0 ? sign : unitOrientationExact(x, y, z);
 }
 
 // Separation [m] along the outward normal of face f of `owner`: the smallest
@@ -57,9 +45,10 @@ double faceSeparation(const Prepared& owner, int f, const Prepared& other,
 	if (owner.separationReady[f]) return owner.separations[f];
 	ensurePlane(owner, f);
 	*owner.tests += other.cornerCount();
+	const double bound = planeRoundoffBound(owner, f, other.lower, other.upper);
 	double separation = std::numeric_limits<double>::infinity();
 	for (int v = 0; v < other.cornerCount(); ++v) {
-		separation = std::min(separation, planeDistance(owner, f, other.corner(v)));
+		separation = std::min(separation, planeDistanceInBox(owner, f, other.corner(v), bound));
 		if (separation < floor) return separation;
 	}
 	owner.separations[f] = separation;
@@ -103,11 +92,9 @@ double projectedSeparation(const Prepared& a, const Prepared& b, const Vector3& 
 // Edge axis of edge ea of A and eb of B when the two edges form a face of the
 // Minkowski difference and are not exactly parallel (nearParallel when they
 // are within the angle tolerance).
-// `cba`: arcSide(a, ea, b, first face of eb), after the caller's check that
-// the two faces of eb are on opposite sides (arcsCross).
-EdgeAxis edgeAxis(const Prepared& a, int ea, const Prepared& b, int eb, double sinTolerance, int cba) {
+// Called for the edge pairs whose Gauss-map arcs cross (searchEdgeAxes).
+EdgeAxis edgeAxis(const Prepared& a, int ea, const Prepared& b, int eb, double sinTolerance) {
 	EdgeAxis axis;
-	if (!arcsCross(a, ea, b, eb, cba)) return axis;
 	const EdgeData& ed = a.edges[ea];
 	const EdgeData& fd = b.edges[eb];
 	const Vector3& da = ed.direction;
@@ -224,41 +211,102 @@ bool searchFaceAxes(const Prepared& a, const Prepared& b, double d0, double hyst
 	return true;
 }
 
+// The edge pairs whose Gauss-map arcs cross, by the signs of arcsCross's
+// four triple products (above), each computed once per (edge, face of the
+// other block) in a table: cba, dba per face g of B for the current edge of
+// A (side[g] = sign of -n_g . arc(ea)), adc, bdc per face f of A and edge
+// of B (rows of faceSigns: sign of n_f . arc(eb)). The same expressions and
+// exact fallback as when each pair computed them (unitOrientation's filter
+// written without branches), so each pair gets the same verdict; the pairs
+// that cross are listed in order (their positions in s.edgesB), written
+// and kept by the test's value rather than by a branch, and their axes
+// computed in the same order as before.
 bool searchEdgeAxes(const Prepared& a, const Prepared& b, double d0, double sinTolerance,
                     const EntranceFeature& previous, Scratch& s, AxisSearch& axes) {
-	// The faces of B at its edges (their planes are built: prepareEdges).
+	// The faces of B at its usable edges (their planes are built:
+	// prepareEdges), minus their normals (C, D), and those edges with their
+	// two faces, in edgeList order.
 	std::vector<int>& bFaces = s.edgeFacesB;
+	std::vector<Vector3>& inward = s.inwardNormalsB;
+	std::vector<std::array<int, 3>>& bEdges = s.edgesB;
 	std::vector<int>& side = s.arcSides;
-	{
-		std::vector<char>& mark = s.faceMark;
-		mark.assign(b.faceCount(), 0);
-		bFaces.clear();
-		for (int eb : b.edgeList) {
-			if (b.internalEdge(eb)) continue;
-			for (int g : b.shape->edgeFaces[eb]) {
-				if (mark[g]) continue;
-				mark[g] = 1;
-				bFaces.push_back(g);
-			}
+	std::vector<char>& mark = s.faceMark;
+	mark.assign(b.faceCount(), 0);
+	bFaces.clear();
+	inward.clear();
+	bEdges.clear();
+	for (int eb : b.edgeList) {
+		if (b.internalEdge(eb)) continue;
+		const auto& fb = b.shape->edgeFaces[eb];
+		bEdges.push_back({eb, fb[0], fb[1]});
+		for (int g : fb) {
+			if (mark[g]) continue;
+			mark[g] = 1;
+			bFaces.push_back(g);
+			inward.push_back(-b.faces[g].normal);
 		}
-		side.resize(b.faceCount());
+	}
+	side.resize(b.faceCount());
+	const int usable = static_cast<int>(bEdges.size());
+	const int faceTotal = static_cast<int>(bFaces.size());
+	s.crossingEdges.resize(usable);
+	int* crossing = s.crossingEdges.data();
+	// adc, bdc: per face of A at a usable edge of A (row faceRow[f]), the
+	// signs of n_f . (D x C) for each usable edge of B.
+	std::vector<int>& faceRow = s.faceRows;
+	std::vector<int>& faceSigns = s.faceSigns;
+	faceRow.assign(a.faceCount(), -1);
+	int rows = 0;
+	for (int ea : a.edgeList) {
+		if (a.internalEdge(ea)) continue;
+		for (int f : a.shape->edgeFaces[ea])
+			if (faceRow[f] < 0) faceRow[f] = rows++;
+	}
+	faceSigns.resize(static_cast<std::size_t>(rows) * usable);
+	for (int f = 0; f < a.faceCount(); ++f) {
+		if (faceRow[f] < 0) continue;
+		const Vector3& normal = a.faces[f].normal;
+		int* row = faceSigns.data() + static_cast<std::size_t>(faceRow[f]) * usable;
+		for (int k = 0; k < usable; ++k) {
+			const std::array<int, 3>& edge = bEdges[k];
+			int sign = filteredSign(normal.dot(b.edges[edge[0]].arc));  // (-D) x (-C) = D x C
+			if (sign == 0) {
+				const Vector3 C = -b.faces[edge[1]].normal, D = -b.faces[edge[2]].normal;
+				sign = unitOrientationExact(normal, D, C);
+			}
+			row[k] = sign;
+		}
 	}
 	for (int ea : a.edgeList) {
 		if (a.internalEdge(ea)) continue;
-		for (int g : bFaces) side[g] = arcSide(a, ea, b, g);
-		for (int eb : b.edgeList) {
-			if (b.internalEdge(eb)) continue;
-			++*a.tests;
-			// Gauss-map arcs that cannot cross (arcsCross's first test).
-			const auto& fb = b.shape->edgeFaces[eb];
-			if (!(side[fb[0]] * side[fb[1]] < 0)) continue;
-			const EdgeAxis axis = edgeAxis(a, ea, b, eb, sinTolerance, side[fb[0]]);
+		const auto& fa = a.shape->edgeFaces[ea];
+		const Vector3& faceA0 = a.faces[fa[0]].normal;  // A
+		const Vector3& faceA1 = a.faces[fa[1]].normal;  // B
+		const Vector3& ba = a.edges[ea].arc;            // B x A
+		for (int k = 0; k < faceTotal; ++k) side[bFaces[k]] = signOfTriple(inward[k], faceA1, faceA0, ba);
+		const int* signsA0 = faceSigns.data() + static_cast<std::size_t>(faceRow[fa[0]]) * usable;
+		const int* signsA1 = faceSigns.data() + static_cast<std::size_t>(faceRow[fa[1]]) * usable;
+		int count = 0;
+		for (int k = 0; k < usable; ++k) {
+			const int cba = side[bEdges[k][1]], dba = side[bEdges[k][2]];
+			const int adc = signsA0[k], bdc = signsA1[k];
+			crossing[count] = k;
+			count += (cba * dba < 0) & (adc * bdc < 0) & (cba * bdc > 0);
+		}
+		// Each usable edge of B counts one test (as when each was tested in
+		// turn): all of them, or those up to a rejecting one.
+		for (int c = 0; c < count; ++c) {
+			const int eb = bEdges[crossing[c]][0];
+			const EdgeAxis axis = edgeAxis(a, ea, b, eb, sinTolerance);
 			if (!axis.valid) continue;
 			if (axis.nearParallel) {
 				axes.nearParallelBest = std::max(axes.nearParallelBest, axis.separation);
 				continue;
 			}
-			if (axis.separation > d0) return false;
+			if (axis.separation > d0) {
+				*a.tests += crossing[c] + 1;
+				return false;
+			}
 			axes.deepestBound = std::max(axes.deepestBound, axis.separation);
 			if (previous.kind == EntranceFeature::EdgePair && previous.feature == ea && previous.other == eb)
 				axes.previousEdge = axis;
@@ -268,6 +316,7 @@ bool searchEdgeAxes(const Prepared& a, const Prepared& b, double d0, double sinT
 				axes.bestEdgeB = eb;
 			}
 		}
+		*a.tests += usable;
 	}
 	return true;
 }

@@ -54,11 +54,34 @@ double insideMargin(const Prepared& block, int f, const Vector3& x) {
 	return margin;
 }
 
+// Whether insideMargin(block, f, x) >= 0, told from signs alone where they
+// suffice (true: it is; false: not known). Most projections lie inside the
+// polygon: for an edge with length > 0 (finite or not), fl(dot / length) has
+// the sign of dot (a rounded quotient keeps its sign; an underflow gives a
+// zero of that sign, and -0 >= 0 as 0 >= 0), so the margin is >= 0 when every
+// such edge has dot >= 0 (a NaN dot fails here and is passed over by
+// insideMargin's std::min); and length = sqrt(squared norm) > 0 exactly when
+// the squared norm is. The same inward vectors and dots, without the square
+// roots and divisions; any other case takes the full margin as before.
+bool insideByMarginSigns(const Prepared& block, int f, const Vector3& x) {
+	const std::vector<int>& face = block.shape->faces[f];
+	const Vector3& n = block.faces[f].normal;
+	for (std::size_t k = 0; k < face.size(); ++k) {
+		const Vector3& a = block.corner(face[k]);
+		const Vector3& b = block.corner(face[(k + 1) % face.size()]);
+		const Vector3 inward = n.cross(b - a);
+		if (!(inward.squaredNorm() > 0)) continue;
+		if (!(inward.dot(x - a) >= 0)) return false;
+	}
+	return true;
+}
+
 // Does x's projection on the plane of face f lie within `reach` [m] of the
 // polygon? (A corner just past a face's edge or corner makes a contact with
 // it; measured as a distance, not per edge line, so that near an acute corner
 // of the face, too, the corner is within sqrt(2) reach of the face.)
 bool projectionNearFace(const Prepared& block, int f, const Vector3& x, double reach) {
+	if (insideByMarginSigns(block, f, x)) return true;
 	const double margin = insideMargin(block, f, x);
 	if (margin >= 0) return true;
 	if (margin < -reach) return false;
@@ -131,16 +154,20 @@ std::optional<SubContact> edgeEdgeContact(bool firstIsA, const Prepared& blockI,
 	// (lengthTolerance > 0). The same pairs are rejected, only sooner.
 	// Every test below only rejects, so their order changes no result.
 	const Vector3 w = p3 - p1;
-	const double sNumerator = w.cross(db).dot(cross), tNumerator = w.cross(da).dot(cross);
+	const double sNumerator = w.cross(db).dot(cross);
+	double tNumerator;
 	{
 		// First without a square root: sLine = sNumerator / nn with nn > 0
 		// (nn = 0 gives no rejection here), so a negative numerator gives a
 		// negative sLine, or -0 for an underflow, which the endpoint test
 		// rejects; and nn is cross.squaredNorm() to within a few DBL_EPSILON
 		// (|cross| rounded, then squared), so a numerator above
-		// (1 + 1e-12) squaredNorm gives sLine > 1.
+		// (1 + 1e-12) squaredNorm gives sLine > 1. s's test before t's
+		// numerator is computed (the tests only reject).
 		const double bound = (1 + 1e-12) * cross.squaredNorm();
-		if (sNumerator < 0 || tNumerator < 0 || sNumerator > bound || tNumerator > bound) return std::nullopt;
+		if (sNumerator < 0 || sNumerator > bound) return std::nullopt;
+		tNumerator = w.cross(da).dot(cross);
+		if (tNumerator < 0 || tNumerator > bound) return std::nullopt;
 	}
 	const double la = da.norm(), lb = db.norm();
 	const double crossNorm = cross.norm();
@@ -301,9 +328,10 @@ void faceEntranceContacts(const Prepared& owner, bool ownerIsA, int f, const Pre
 	std::vector<char>& ready = s.cornerDistanceReady;
 	distances.resize(other.cornerCount());
 	ready.assign(other.cornerCount(), 0);
+	const double bound = planeRoundoffBound(owner, f, other.lower, other.upper);
 	const auto distance = [&](int v) {
 		if (!ready[v]) {
-			distances[v] = planeDistance(owner, f, other.corner(v));
+			distances[v] = planeDistanceInBox(owner, f, other.corner(v), bound);
 			ready[v] = 1;
 			++*owner.tests;
 		}
