@@ -81,7 +81,7 @@ class DDAScene:
         its part and the clump to the block."""
         ids = [member.id for member in spec.members]
         clumps = {O.bodies[i].clumpId if i >= 0 and O.bodies[i] is not None else -1 for i in ids}
-        if len(clumps) != 1 or -1 in clumps or clumps == {ids[0]}:
+        if len(clumps) != 1 or -1 in clumps:
             raise ValueError('the members of a concave block (bodies %s) must be appended together, as one clump: '
                              'O.bodies.appendClumped(concaveBlock(parts, ...)); they are not one clump now (clump '
                              'ids %s)' % (ids, sorted(clumps)))
