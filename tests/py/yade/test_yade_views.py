@@ -140,8 +140,9 @@ def test_separated_blocks_have_no_interaction_and_thrown_block_loses_it():
     assert (1, 2) in _closedPairs() and _realPairs() == _closedPairs()
 
 
-def _sphereOnWall(withDDA):
-    """A YADE sphere on a YADE wall, beside a DDA block on a floor when withDDA."""
+def _sphereOnWall(withDDA, polyhedraFunctor=False):
+    """A YADE sphere on a YADE wall, beside a DDA block on a floor when withDDA; polyhedraFunctor: YADE's
+    InteractionLoop also has a geometry functor for Polyhedra (masks keep YADE's collider off the blocks)."""
     if withDDA:
         rock = material(O, young=1e10)
         O.bodies.append(yade_dda.ddaBlock(box((-3, -3, -1), (3, 3, 0)), material=rock, fixed=True, mask=2))
@@ -150,7 +151,9 @@ def _sphereOnWall(withDDA):
     wall = O.bodies.append(utils.wall(-5, axis=2, mask=1, material=soft))
     sphere = O.bodies.append(utils.sphere((10, 0, -4.5), 0.5, mask=1, material=soft))
     O.engines = [wrapper.ForceResetter(), wrapper.InsertionSortCollider([wrapper.Bo1_Sphere_Aabb(), wrapper.Bo1_Wall_Aabb()]),
-                 wrapper.InteractionLoop([wrapper.Ig2_Wall_Sphere_ScGeom()], [wrapper.Ip2_FrictMat_FrictMat_FrictPhys()],
+                 wrapper.InteractionLoop([wrapper.Ig2_Wall_Sphere_ScGeom()] +
+                                         ([wrapper.Ig2_Polyhedra_Polyhedra_PolyhedraGeom()] if polyhedraFunctor else []),
+                                         [wrapper.Ip2_FrictMat_FrictMat_FrictPhys()],
                                          [wrapper.Law2_ScGeom_FrictPhys_CundallStrack()]),
                  wrapper.NewtonIntegrator(gravity=(0, 0, -G), mask=1, damping=0.4)]
     if withDDA:
@@ -162,11 +165,14 @@ def _sphereOnWall(withDDA):
 
 def test_mixed_scene_keeps_yade_forces():
     """A YADE sphere resting on a YADE wall beside a DDA block: its interaction and O.forces are
-    YADE's, bitwise those of the same YADE scene without DDA; the DDA pair is not put into
-    O.interactions while a live InteractionLoop runs (it would stop YADE on a Polyhedra pair it
-    has no functor for), but the block's force is in O.forces."""
+    YADE's, bitwise those of the same YADE scene without DDA; the DDA pair is in O.interactions too,
+    real, with DDA's geometry and forces (YADE's InteractionLoop, with no functor for Polyhedra, leaves
+    it alone), and the block's force is in O.forces."""
     wall, sphere = _sphereOnWall(True)
-    assert _realPairs() == {(wall, sphere)}
+    assert _realPairs() == {(wall, sphere), (0, 1)}
+    dda = O.interactions[0, 1]
+    assert type(dda.geom) is wrapper.PolyhedraGeom and type(dda.phys) is wrapper.PolyhedraPhys
+    assert dda.phys.normalForce[2] == pytest.approx(WEIGHT, rel=1e-3)   # the force on id2, the block
     i = O.interactions[wall, sphere]
     assert type(i.phys) is wrapper.FrictPhys
     assert O.forces.f(sphere)[2] > 0   # the wall pushes it (it is still bouncing a little)
@@ -175,6 +181,15 @@ def test_mixed_scene_keeps_yade_forces():
     O.reset()
     wall, sphere = _sphereOnWall(False)
     assert (tuple(O.forces.f(sphere)), tuple(O.forces.t(sphere)), tuple(O.bodies[sphere].state.pos)) == (force, torque, pos)
+
+
+def test_a_yade_loop_with_a_polyhedra_functor_keeps_no_dda_interactions():
+    """The same mixed scene with a Polyhedra geometry functor in YADE's InteractionLoop: it would compute
+    YADE's own contact on a DDA pair put into O.interactions, so none is kept; the block's force is still
+    in O.forces."""
+    wall, sphere = _sphereOnWall(True, polyhedraFunctor=True)
+    assert _realPairs() == {(wall, sphere)}
+    assert O.forces.f(1) == pytest.approx((0, 0, WEIGHT), rel=1e-3)
 
 
 def _fingerprint():
@@ -245,4 +260,4 @@ def test_a_dda_step_leaves_yades_thread_count_alone():
     O.step()
     O.reset()
     wall, sphere = _sphereOnWall(True)
-    assert _realPairs() == {(wall, sphere)}
+    assert _realPairs() == {(wall, sphere), (0, 1)}
