@@ -78,7 +78,7 @@ struct Contact {
 	double normalStiffness = 0;  // [N/m]
 	double shearStiffness = 0;   // [N/m]
 	double frictionTangent = 0;  // tan(friction angle) [-]
-	double area = 0;             // share of its pair's contact area [m^2]
+	double area = 0;             // share of its pair's contact area [m^2]; 0 when the pair has no bond strength (only bonds use it)
 	double cohesionForce = 0;    // bond's shear strength beyond friction [N]
 	double tensileForce = 0;     // bond's tensile strength [N]
 	bool isNew = true;           // no history was found

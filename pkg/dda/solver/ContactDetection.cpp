@@ -231,7 +231,12 @@ void ContactDetection::detectChunk(Step& step, int begin, int count, int chunk) 
 			    BlockGeometry{B.shape.get(), &B.vertices, interiorPoint(B), internalB, &planes_[planeSlot_[b]]},
 			    detection, pairResults_[q], step.store.previousEntrance(a, b), step.collider.linked(begin + q),
 			    &pairWork_[q]);
-			if (pairFound_[q]) pairArea_[q] = contactArea(pairResults_[q]);
+			// The contact area feeds only the bond strengths (prepareContact: the
+			// smaller cohesion and tensile strength of the pair times it): a pair
+			// without both leaves it 0 and the forces are the same 0.
+			const bool bonded = std::min(A.material.cohesion, B.material.cohesion) > 0 ||
+			                    std::min(A.material.tensileStrength, B.material.tensileStrength) > 0;
+			if (pairFound_[q]) pairArea_[q] = bonded ? contactArea(pairResults_[q]) : 0.0;
 		}
 	}
 	releasePlanes(begin, next, chunk);
