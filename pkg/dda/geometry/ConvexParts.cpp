@@ -1,5 +1,7 @@
 #include "ConvexParts.hpp"
 
+#include "InternalFaces.hpp"
+
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -80,15 +82,16 @@ double smallestOverlap(const PartView& a, const PartView& b) {
 	return smallest;
 }
 
-bool insidePolygon(const Vector3& x, const ConvexPolyhedron& p, const std::vector<int>& face, const Vector3& n,
-                   double tolerance) {
-	for (std::size_t k = 0; k < face.size(); ++k) {
-		const Vector3& s = p.vertices[face[k]];
-		const Vector3 inward = n.cross(p.vertices[face[(k + 1) % face.size()]] - s);
-		const double length = inward.norm();
-		if (length > 0 && (x - s).dot(inward) < -tolerance * length) return false;
-	}
-	return true;
+// The length tolerance of a pair of parts [m] (kCoplanarRelativeTolerance x
+// the larger bounding-box diagonal), or a negative value when their boxes,
+// grown by it, do not meet (no face of theirs can touch).
+double touchingTolerance(const PartView& a, const PartView& b) {
+	const double tolerance =
+	    kCoplanarRelativeTolerance * std::max(a.box.diagonal().norm(), b.box.diagonal().norm());
+	Eigen::AlignedBox3d grown = a.box;
+	grown.min().array() -= tolerance;
+	grown.max().array() += tolerance;
+	return grown.intersects(b.box) ? tolerance : -1.0;
 }
 
 // A face f of part a and a face g of part b that share a region of positive
@@ -120,8 +123,8 @@ bool shareFace(const PartView& a, const PartView& b, double tolerance, PartialFa
 			const double area = std::abs(signedArea(clipConvex(pa, pb)));
 			if (area <= tolerance * std::max(a.box.diagonal().norm(), b.box.diagonal().norm())) continue;
 			bool fCovered = true, gCovered = true;
-			for (int v : A.faces[f]) fCovered = fCovered && insidePolygon(A.vertices[v], B, B.faces[g], b.normals[g], tolerance);
-			for (int v : B.faces[g]) gCovered = gCovered && insidePolygon(B.vertices[v], A, A.faces[f], nf, tolerance);
+			for (int v : A.faces[f]) fCovered = fCovered && insideFacePolygon(A.vertices[v], B.vertices, B.faces[g], b.normals[g], tolerance);
+			for (int v : B.faces[g]) gCovered = gCovered && insideFacePolygon(B.vertices[v], A.vertices, A.faces[f], nf, tolerance);
 			if (!fCovered && !gCovered && partial && partial->f < 0)
 				*partial = PartialFaces{static_cast<int>(f), static_cast<int>(g), area};
 			if (every) every->push_back(PartialFaces{static_cast<int>(f), static_cast<int>(g), area});
@@ -190,12 +193,8 @@ bool conformOnce(std::vector<std::vector<Vector3>>& parts) {
 	for (std::size_t a = 0; a < parts.size(); ++a)
 		for (std::size_t b = 0; b < parts.size(); ++b) {
 			if (a == b) continue;
-			const double tolerance =
-			    kCoplanarRelativeTolerance * std::max(views[a].box.diagonal().norm(), views[b].box.diagonal().norm());
-			Eigen::AlignedBox3d grown = views[a].box;
-			grown.min().array() -= tolerance;
-			grown.max().array() += tolerance;
-			if (!grown.intersects(views[b].box)) continue;
+			const double tolerance = touchingTolerance(views[a], views[b]);
+			if (tolerance < 0) continue;
 			PartialFaces partial;
 			shareFace(views[a], views[b], tolerance, &partial);
 			if (partial.f < 0) continue;
@@ -241,12 +240,8 @@ void checkConvexParts(const std::vector<ConvexPolyhedron>& parts) {
 	};
 	for (int a = 0; a < n; ++a)
 		for (int b = a + 1; b < n; ++b) {
-			const double tolerance = kCoplanarRelativeTolerance *
-			                         std::max(views[a].box.diagonal().norm(), views[b].box.diagonal().norm());
-			Eigen::AlignedBox3d grown = views[a].box;
-			grown.min().array() -= tolerance;
-			grown.max().array() += tolerance;
-			if (!grown.intersects(views[b].box)) continue;
+			const double tolerance = touchingTolerance(views[a], views[b]);
+			if (tolerance < 0) continue;
 			const double overlap = smallestOverlap(views[a], views[b]);
 			if (overlap > tolerance) {
 				std::ostringstream message;
@@ -297,13 +292,11 @@ std::vector<SharedFace> sharedFaces(const std::vector<ConvexPolyhedron>& polyhed
 	for (int s = 0; s < n; ++s)
 		for (int t = s + 1; t < n; ++t) {
 			const int a = std::min(order[s], order[t]), b = std::max(order[s], order[t]);
-			const double tolerance = kCoplanarRelativeTolerance *
-			                         std::max(views[a].box.diagonal().norm(), views[b].box.diagonal().norm());
-			if (views[order[t]].box.min().x() > views[order[s]].box.max().x() + tolerance) break;
-			Eigen::AlignedBox3d grown = views[a].box;
-			grown.min().array() -= tolerance;
-			grown.max().array() += tolerance;
-			if (!grown.intersects(views[b].box)) continue;
+			const double reach = kCoplanarRelativeTolerance *
+			                     std::max(views[a].box.diagonal().norm(), views[b].box.diagonal().norm());
+			if (views[order[t]].box.min().x() > views[order[s]].box.max().x() + reach) break;
+			const double tolerance = touchingTolerance(views[a], views[b]);
+			if (tolerance < 0) continue;
 			std::vector<PartialFaces> pairs;
 			shareFace(views[a], views[b], tolerance, nullptr, &pairs);
 			for (const PartialFaces& p : pairs) found.push_back(SharedFace{a, p.f, b, p.g, p.area});

@@ -7,11 +7,8 @@
 
 namespace dda {
 
-namespace {
-// Corner x lies in the convex polygon `face` of `vertices` (normal n,
-// counter-clockwise seen from outside), within `tolerance` [m].
-bool insidePolygon(const Vector3& x, const std::vector<Vector3>& vertices, const std::vector<int>& face,
-                   const Vector3& n, double tolerance) {
+bool insideFacePolygon(const Vector3& x, const std::vector<Vector3>& vertices, const std::vector<int>& face,
+                       const Vector3& n, double tolerance) {
 	for (std::size_t k = 0; k < face.size(); ++k) {
 		const Vector3& p = vertices[face[k]];
 		const Vector3& q = vertices[face[(k + 1) % face.size()]];
@@ -22,6 +19,7 @@ bool insidePolygon(const Vector3& x, const std::vector<Vector3>& vertices, const
 	return true;
 }
 
+namespace {
 // Marks the faces of bodies a and b that cover each other (see markInternalFaces).
 void markCoveredFaces(const PlacedPolyhedron& A, const PlacedPolyhedron& B, double tolerance,
                       double parallelAngleTolerance, std::vector<char>& internalA, std::vector<char>& internalB) {
@@ -38,9 +36,9 @@ void markCoveredFaces(const PlacedPolyhedron& A, const PlacedPolyhedron& B, doub
 			if (!coplanar) continue;
 			bool fCovered = true, gCovered = true;
 			for (int v : A.shape->faces[f])
-				fCovered = fCovered && insidePolygon(verticesA[v], verticesB, B.shape->faces[g], ng, tolerance);
+				fCovered = fCovered && insideFacePolygon(verticesA[v], verticesB, B.shape->faces[g], ng, tolerance);
 			for (int v : B.shape->faces[g])
-				gCovered = gCovered && insidePolygon(verticesB[v], verticesA, A.shape->faces[f], nf, tolerance);
+				gCovered = gCovered && insideFacePolygon(verticesB[v], verticesA, A.shape->faces[f], nf, tolerance);
 			if (fCovered) internalA[f] = 1;
 			if (gCovered) internalB[g] = 1;
 		}

@@ -16,6 +16,13 @@ struct PlacedPolyhedron {
 	const std::vector<Vector3>* vertices = nullptr;
 };
 
+// Whether point x lies in the convex polygon `face` of `vertices` (outward
+// normal n, counter-clockwise seen from outside), within `tolerance` [m] of
+// each of its edges (the coverage test of flush faces here and of concave
+// blocks' shared faces, ConvexParts.cpp).
+bool insideFacePolygon(const Vector3& x, const std::vector<Vector3>& vertices, const std::vector<int>& face,
+                       const Vector3& n, double tolerance);
+
 // Marks, for every body given (World: every fixed block), the faces fully
 // covered by a coplanar, opposed face of another given body (flush joints):
 // see BlockGeometry::internalFaces. internal[b] is empty for a body left out,
