@@ -57,12 +57,14 @@ std::vector<Block> makeConcaveBlock(const std::vector<std::vector<Vector3>>& par
 	std::vector<MassProperties> properties;
 	for (std::size_t p = 0; p < parts.size(); ++p) {
 		try {
-			polyhedra.push_back(buildConvexPolyhedron(parts[p]));
 			blocks.push_back(makeBlock(parts[p], material, fixed, rigid));
 		} catch (const InputError& error) {
 			throw InputError("part " + std::to_string(p) + " of the concave block: " + error.what());
 		}
 		const Block& b = blocks.back();
+		ConvexPolyhedron& polyhedron = polyhedra.emplace_back();  // the part's hull, as makeBlock made it
+		static_cast<PolyhedronTopology&>(polyhedron) = *b.shape;
+		polyhedron.vertices = b.vertices;
 		properties.push_back(MassProperties{b.volume, b.centroid, b.secondMoment});
 	}
 	checkConvexParts(polyhedra);
