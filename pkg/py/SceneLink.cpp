@@ -51,9 +51,10 @@ void SceneLink::link(int blockIndex, int bodyId, const Vector3& position0, const
 	const Eigen::Quaterniond inverse = (b.rotation * link.orientation0).conjugate();
 	std::vector<Vector3> blockLocal(n);
 	double radius = 0;
+	const Vector3 centre = partPosition(blockIndex);
 	for (std::size_t j = 0; j < n; ++j) {
 		blockLocal[j] = inverse * (b.vertices[j] - position0);
-		radius = std::max(radius, (b.vertices[j] - partPosition(blockIndex)).norm());
+		radius = std::max(radius, (b.vertices[j] - centre).norm());
 	}
 	const double eps = std::numeric_limits<double>::epsilon();
 	const double tolerance = eps * (kPositionRoundoff * position0.norm() + kFrameRoundoff * radius);
@@ -164,10 +165,10 @@ Vector3 SceneLink::partPosition(int block) const {
 	return computeMassProperties(b.vertices, b.shape->faces).centroid;
 }
 
-Vector3 SceneLink::partVelocity(int block) const {
+Vector3 SceneLink::partVelocity(int block, const Vector3& position) const {
 	const Block& body = world.block(world.bodyOf(block));
 	if (!world.block(block).isPart()) return body.velocity.head<3>();
-	return displacementAt(partPosition(block) - body.centroid, body.velocity);
+	return displacementAt(position - body.centroid, body.velocity);
 }
 
 Eigen::Quaterniond SceneLink::bodyOrientation(int blockIndex) const {
@@ -176,13 +177,12 @@ Eigen::Quaterniond SceneLink::bodyOrientation(int blockIndex) const {
 	return (world.block(blockIndex).rotation * base).normalized();
 }
 
-std::vector<Vector3> SceneLink::localVertices(int blockIndex) const {
+std::vector<Vector3> SceneLink::localVertices(int blockIndex, const Vector3& position) const {
 	const Block& b = world.block(blockIndex);
 	const BodyLink* link = bodyLink(blockIndex);
 	const Eigen::Quaterniond inverse = bodyOrientation(blockIndex).conjugate();
 	std::vector<Vector3> local;
 	if (!link) return local;
-	const Vector3 position = partPosition(blockIndex);
 	for (int j : link->vertexOrder) local.push_back(inverse * (b.vertices[j] - position));
 	return local;
 }

@@ -73,9 +73,10 @@ public:
 	// part of a concave block the part's own (the body of a concave block
 	// holds the whole block's centroid; its own part's is computed).
 	Vector3 partPosition(int block) const;
-	// Velocity of that point [m/s] (of the block's body's motion).
-	Vector3 partVelocity(int block) const;
-	std::vector<Vector3> localVertices(int block) const;
+	// Velocity [m/s] of the block's point at `position` (its partPosition) in its body's motion.
+	Vector3 partVelocity(int block, const Vector3& position) const;
+	// The block's corners in its YADE body's frame, the body at `position` (its partPosition) [m].
+	std::vector<Vector3> localVertices(int block, const Vector3& position) const;
 
 	// World::reserveBlocks, and as much room in the body links.
 	void reserveBlocks(int extra);

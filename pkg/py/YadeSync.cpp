@@ -101,16 +101,17 @@ int YadeSync::writeBodies(SceneLink& s, const py::object& bodies, bool all) {
 		PyObject* state = body.state.ptr();
 		// A part of a concave block: its own centroid, moving with its body.
 		const Block& moving = b.isPart() ? s.world.block(s.world.bodyOf(i)) : b;
-		setVector(state, n.pos, b.isPart() ? s.partPosition(i) : b.centroid);
+		const Vector3 position = b.isPart() ? s.partPosition(i) : b.centroid;
+		setVector(state, n.pos, position);
 		*quaternionValue_ = s.bodyOrientation(i);
 		check(PyObject_SetAttr(state, n.ori, quaternion_.ptr()));
-		setVector(state, n.vel, b.isPart() ? s.partVelocity(i) : b.velocity.head<3>());
+		setVector(state, n.vel, b.isPart() ? s.partVelocity(i, position) : b.velocity.head<3>());
 		setVector(state, n.angVel, moving.velocity.segment<3>(3));
 		// Vertices in the body's local frame and vertex order: at the first
 		// write (YADE's frame is at YADE's centroid, the core's at its own:
 		// they differ by round-off), then when strained since the last one.
 		if (all || first || b.unsyncedStrain > SceneLink::kVertexSyncStrain) {
-			const std::vector<Vector3> local = s.localVertices(i);
+			const std::vector<Vector3> local = s.localVertices(i, position);
 			const VertexList& list = vertexList(local.size());
 			for (std::size_t k = 0; k < local.size(); ++k) *list.values[k] = local[k];
 			check(PyObject_SetAttr(body.shape.ptr(), n.v, list.list.ptr()));

@@ -376,37 +376,41 @@ py::tuple pythonColliderNames() {
 	return py::tuple(names);
 }
 
+// Convex parts [m] from Python (a list of corner lists), and back as lists of (x, y, z) tuples.
+std::vector<std::vector<Vector3>> partsFrom(const py::object& parts) {
+	std::vector<std::vector<Vector3>> corners;
+	for (long k = 0, n = py::len(parts); k < n; ++k) corners.push_back(toPoints(parts[k], "part corners"));
+	return corners;
+}
+py::list partsTo(const std::vector<std::vector<Vector3>>& parts) {
+	py::list out;
+	for (const std::vector<Vector3>& part : parts) {
+		py::list corners;
+		for (const Vector3& x : part) corners.append(py::make_tuple(x.x(), x.y(), x.z()));
+		out.append(corners);
+	}
+	return out;
+}
+
 // A concave block from its convex parts (lists of corners [m]); returns its body's index.
 int addConcaveBlock(SceneLink& s, const py::object& parts, double density, double young, double poisson,
                     double frictionAngle, double cohesion, double tensileStrength, bool fixed, bool rigid) {
-	std::vector<std::vector<Vector3>> corners;
-	for (long k = 0, n = py::len(parts); k < n; ++k) corners.push_back(toPoints(parts[k], "part corners"));
-	return s.world.addConcaveBlock(corners, Material{density, young, poisson, frictionAngle, cohesion, tensileStrength},
-	                               fixed, rigid);
+	return s.world.addConcaveBlock(partsFrom(parts),
+	                               Material{density, young, poisson, frictionAngle, cohesion, tensileStrength}, fixed,
+	                               rigid);
 }
 
 // Raises ValueError naming the problem if the parts and material cannot make a concave block.
 void checkConcaveBlock(const py::object& parts, double density, double young, double poisson, double frictionAngle,
                        double cohesion, double tensileStrength) {
-	std::vector<std::vector<Vector3>> corners;
-	for (long k = 0, n = py::len(parts); k < n; ++k) corners.push_back(toPoints(parts[k], "part corners"));
-	makeConcaveBlock(corners, Material{density, young, poisson, frictionAngle, cohesion, tensileStrength}, false);
+	makeConcaveBlock(partsFrom(parts), Material{density, young, poisson, frictionAngle, cohesion, tensileStrength},
+	                 false);
 }
 
-// conformParts on corner lists [m]: the parts split so that shared faces match (lists of tuples).
-py::list pythonConformParts(const py::object& parts) {
-	std::vector<std::vector<Vector3>> corners;
-	for (long k = 0, n = py::len(parts); k < n; ++k) corners.push_back(toPoints(parts[k], "part corners"));
-	py::list out;
-	for (const std::vector<Vector3>& part : conformParts(corners)) {
-		py::list points;
-		for (const Vector3& x : part) points.append(py::make_tuple(x.x(), x.y(), x.z()));
-		out.append(points);
-	}
-	return out;
-}
+// conformParts on corner lists [m]: the parts split so that shared faces match.
+py::list pythonConformParts(const py::object& parts) { return partsTo(conformParts(partsFrom(parts))); }
 
-// convexDecomposition of a closed surface: points [m] and triangles (index triples); lists of tuples.
+// convexDecomposition of a closed surface: points [m] and triangles (index triples).
 py::list pythonConvexDecomposition(const py::object& points, const py::object& triangles) {
 	std::vector<std::array<int, 3>> tris;
 	for (long t = 0, n = py::len(triangles); t < n; ++t) {
@@ -414,13 +418,7 @@ py::list pythonConvexDecomposition(const py::object& points, const py::object& t
 		if (py::len(tri) != 3) throw InputError("triangle " + std::to_string(t) + " must have 3 corner indices");
 		tris.push_back({py::extract<int>(tri[0])(), py::extract<int>(tri[1])(), py::extract<int>(tri[2])()});
 	}
-	py::list out;
-	for (const std::vector<Vector3>& part : convexDecomposition(toPoints(points, "surface points"), tris)) {
-		py::list corners;
-		for (const Vector3& x : part) corners.append(py::make_tuple(x.x(), x.y(), x.z()));
-		out.append(corners);
-	}
-	return out;
+	return partsTo(convexDecomposition(toPoints(points, "surface points"), tris));
 }
 
 void linkClump(SceneLink& s, int block, int clumpId, const Eigen::Quaterniond& orientation) {
