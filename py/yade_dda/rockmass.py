@@ -135,12 +135,14 @@ class RockMass:
             return i
 
         identity = [tuple(sorted(b.planes)) for b in self.blocks]   # a block is known by its planes
+        joints = [(p, _unitPlane(p)) for p in self.planes if p.kind in _JOINT_KINDS]
+        tolerance = 1e-9 * self.domainVolume ** (1.0 / 3.0)
         self.jointArea = self.absentArea = 0.0
         for a, f, b, g, area in _core.sharedFaces([(blk.corners, blk.faces) for blk in self.blocks]):
             plane = self.planes[self.blocks[a].planes[f]]
             if plane.kind == 'domain':
                 # The boundary between two domain parts is no joint, unless a joint plane lies on it.
-                plane = self._jointOn(plane) or plane
+                plane = _jointOn(plane, joints, tolerance) or plane
             if plane.kind == 'domain':
                 join = True
             elif plane.kind in _JOINT_KINDS and persistences[plane.source] < 1:
@@ -159,19 +161,15 @@ class RockMass:
         self.groups = [tuple(members[r]) for r in sorted(members)]
 
 
-    def _jointOn(self, plane):
-        """The joint plane (kind 'set' or 'joint') that coincides with `plane` (normals parallel, offsets equal
-        within 1e-9 of the domain's size), or None."""
-        if not hasattr(self, '_joints'):
-            size = self.domainVolume ** (1.0 / 3.0)
-            self._joints = [(p, _unitPlane(p)) for p in self.planes if p.kind in _JOINT_KINDS], 1e-9 * size
-        joints, tolerance = self._joints
-        n, d = _unitPlane(plane)
-        for joint, (m, e) in joints:
-            c = sum(n[k] * m[k] for k in range(3))
-            if abs(abs(c) - 1) < 1e-12 and abs(d - (e if c > 0 else -e)) <= tolerance:
-                return joint
-        return None
+def _jointOn(plane, joints, tolerance):
+    """The joint plane among `joints` ((RockPlane, its _unitPlane) of kind 'set' or 'joint') that coincides
+    with `plane`: normals parallel, offsets equal within `tolerance` [m]; None when there is none."""
+    n, d = _unitPlane(plane)
+    for joint, (m, e) in joints:
+        c = sum(n[k] * m[k] for k in range(3))
+        if abs(abs(c) - 1) < 1e-12 and abs(d - (e if c > 0 else -e)) <= tolerance:
+            return joint
+    return None
 
 
 def _unitPlane(plane):
