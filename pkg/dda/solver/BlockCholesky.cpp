@@ -1,5 +1,6 @@
 #include "BlockCholesky.hpp"
 
+#include "BlockKernels.hpp"
 #include "dda/core/CapacityBytes.hpp"
 
 #include <Eigen/OrderingMethods>
@@ -115,8 +116,8 @@ bool BlockCholesky::factorize(const Matrix12* diagonal, const Matrix12* offDiago
 		for (int p = first; p < last; ++p) pivots_[j].matrixU().solveInPlace<Eigen::OnTheRight>(factor_[p]);
 		for (int p = first; p < last; ++p) {
 			const Matrix12& lij = factor_[p];
-			diagonal_[rows_[p]].noalias() -= lij * lij.transpose();
-			for (int q = first; q < p; ++q) factor_[*target++].noalias() -= lij * factor_[q].transpose();
+			subtractProductTransposed(diagonal_[rows_[p]], lij, lij);
+			for (int q = first; q < p; ++q) subtractProductTransposed(factor_[*target++], lij, factor_[q]);
 		}
 	}
 	return true;

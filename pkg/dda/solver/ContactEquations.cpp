@@ -149,14 +149,33 @@ TangentialTerm tangentialTerm(const Contact& contact) {
 	return contact.slipping ? TangentialTerm::FrictionLoad : TangentialTerm::ShearSpring;
 }
 
-bool contactTerms(const Contact& contact, const Block& blockI, const Block& blockJ, Matrix24& stiffness,
-                  Vector24& force) {
+void tangentBasis(const Vector3& normal, Vector3& t1, Vector3& t2) {
+	// Crossed with the coordinate axis least aligned with the normal, so
+	// never with a near-parallel one.
+	const Vector3 a = normal.cwiseAbs();
+	const int axis = a.x() <= a.y() && a.x() <= a.z() ? 0 : (a.y() <= a.z() ? 1 : 2);
+	t1 = normal.cross(Vector3::Unit(axis)).normalized();
+	t2 = normal.cross(t1).normalized();
+}
+
+Matrix24 ContactTerms::stiffness() const {
+	Matrix24 k = Matrix24::Zero();
+	for (int r = 0; r < rank; ++r) k.noalias() += (weight[r] * vector[r]) * vector[r].transpose();
+	return k;
+}
+
+bool contactTerms(const Contact& contact, const Block& blockI, const Block& blockJ, ContactTerms& terms) {
 	const ContactHistory& trial = contact.trial;
 	const TangentialTerm tangential = tangentialTerm(contact);
 	const bool normalTerms = hasNormalTerms(contact);
+	terms.rank = 0;
 	if (!normalTerms && tangential == TangentialTerm::None) return false;
-	stiffness.setZero();
-	force.setZero();
+	terms.force.setZero();
+	auto add = [&terms](double weight, const Vector24& v) {
+		terms.weight[terms.rank] = weight;
+		terms.vector[terms.rank] = v;
+		++terms.rank;
+	};
 	if (normalTerms) {
 		const Vector24 e = stacked(contact.normal.ei, contact.normal.ej);
 		const double kn = contact.normalStiffness;
@@ -166,12 +185,11 @@ bool contactTerms(const Contact& contact, const Block& blockI, const Block& bloc
 			const double d0 = contact.normal.d0, dk = contact.trialGap;
 			const NormalSecant h = normalSecant(trial.bonded, kn, d0, dk);
 			const double spring = closed(trial.state) ? contact.springWeight * kn : 0.0;
-			const double curvature = spring + contact.secantWeight * h.slope;
-			stiffness.noalias() = curvature * e * e.transpose();
-			force.noalias() = (-spring * d0 + contact.secantWeight * (h.slope * (dk - d0) - h.value)) * e;
+			add(spring + contact.secantWeight * h.slope, e);
+			terms.force.noalias() = (-spring * d0 + contact.secantWeight * (h.slope * (dk - d0) - h.value)) * e;
 		} else {
-			stiffness.noalias() = kn * e * e.transpose();
-			force.noalias() = -kn * contact.normal.d0 * e;
+			add(kn, e);
+			terms.force.noalias() = -kn * contact.normal.d0 * e;
 		}
 	}
 	if (tangential == TangentialTerm::None) return true;
@@ -181,10 +199,14 @@ bool contactTerms(const Contact& contact, const Block& blockI, const Block& bloc
 	const Eigen::Matrix<double, 3, 24> G = relativeDisplacementMatrix(blockI, trial.anchorI, blockJ, trial.anchorJ);
 	const Vector3 separation = trial.anchorI - trial.anchorJ;
 	if (tangential == TangentialTerm::ShearSpring) {
+		// G^T P G = (G^T t1)(G^T t1)^T + (G^T t2)(G^T t2)^T.
 		const Matrix3 P = tangentProjector(contact.geometry.normal);
 		const double ks = contact.shearStiffness;
-		stiffness.noalias() += (weight * ks) * G.transpose() * P * G;
-		force.noalias() -= (weight * ks) * G.transpose() * (P * separation);
+		Vector3 t1, t2;
+		tangentBasis(contact.geometry.normal, t1, t2);
+		add(weight * ks, G.transpose() * t1);
+		add(weight * ks, G.transpose() * t2);
+		terms.force.noalias() -= (weight * ks) * G.transpose() * (P * separation);
 	} else {
 		// G^T C G as the outer product of G^T m with itself (symmetric and
 		// positive semi-definite to round-off; see slipStiffness).
@@ -194,10 +216,19 @@ bool contactTerms(const Contact& contact, const Block& blockI, const Block& bloc
 		const Vector3 m = contact.geometry.normal.cross(l).normalized();
 		const double c = weight * contact.slipLimit / stretch;
 		const Vector24 Gm = G.transpose() * m;
-		stiffness.noalias() += c * Gm * Gm.transpose();
-		force.noalias() -= G.transpose() * ((weight * contact.slipLimit) * l) + (c * m.dot(separation)) * Gm;
+		add(c, Gm);
+		terms.force.noalias() -= G.transpose() * ((weight * contact.slipLimit) * l) + (c * m.dot(separation)) * Gm;
 	}
 	return true;
+}
+
+bool contactTerms(const Contact& contact, const Block& blockI, const Block& blockJ, Matrix24& stiffness,
+                  Vector24& force) {
+	ContactTerms terms;
+	const bool any = contactTerms(contact, blockI, blockJ, terms);
+	stiffness = terms.stiffness();
+	force = any ? terms.force : Vector24::Zero();
+	return any;
 }
 
 namespace {

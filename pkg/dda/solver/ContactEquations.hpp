@@ -69,10 +69,32 @@ using Matrix24 = Eigen::Matrix<double, 24, 24>;
 // from the two blocks (block i owns the vertex or first edge).
 void prepareContact(Contact& contact, const Block& blockI, const Block& blockJ, const IntegratorSettings& settings);
 
-// The contact's 24x24 stiffness and 24 force terms of its Newton model at
-// its trial state (see above); false (nothing to add) when it is open.
+// The contact's terms in the step's equations, its Newton model at its
+// trial state (see above): the stiffness K = sum_r weight[r] v[r] v[r]^T,
+// at most three terms of rank one (the normal spring's e; the stick
+// spring's G^T t1 and G^T t2, t1 and t2 an orthonormal basis of the tangent
+// plane, since P = t1 t1^T + t2 t2^T; the slip's G^T m), and the force F.
+// Kept as vectors rather than as the 24x24 K: a sixth of the memory, and
+// the assembly adds each term's 12x12 outer products straight into the
+// coupled system's blocks instead of copying blocks out of K.
+struct ContactTerms {
+	int rank = 0;
+	double weight[3] = {0, 0, 0};
+	Vector24 vector[3];
+	Vector24 force;
+	// K as a matrix (for tests and checks).
+	Matrix24 stiffness() const;
+};
+
+// The contact's terms (above); false (nothing to add) when it is open.
+bool contactTerms(const Contact& contact, const Block& blockI, const Block& blockJ, ContactTerms& terms);
+
+// The same as the 24x24 stiffness and the 24 force.
 bool contactTerms(const Contact& contact, const Block& blockI, const Block& blockJ, Matrix24& stiffness,
                   Vector24& force);
+
+// An orthonormal basis (t1, t2) of the plane normal to the unit `normal`.
+void tangentBasis(const Vector3& normal, Vector3& t1, Vector3& t2);
 
 // Which tangential term contactTerms adds for the contact's trial state: the
 // stick spring of a locked contact, the slip force of a sliding one with a

@@ -117,11 +117,7 @@ private:
 	// would be correct but useless: the gap is that of the last solve, which
 	// differs at every solve that moves the contact.) Under Shi's scheme
 	// secantWeight is 0 and this is the rule as first written.
-	struct KeptTerms {
-		Matrix24 stiffness;
-		Vector24 force;
-	};
-	std::vector<KeptTerms> keptTerms_;
+	std::vector<ContactTerms> keptTerms_;
 	std::vector<int> keptTermsOf_;             // per contact: its entry of keptTerms_, -1 if none
 	std::vector<unsigned char> keptTermsKey_;  // per contact: the state its kept terms are for
 	bool keepTerms_ = true;

@@ -12,7 +12,7 @@ namespace dda {
 
 namespace {
 // Heap for the contact terms kept within an attempt
-// (OpenCloseIteration::keptTerms_): about 3,400 contacts; the others' terms
+// (OpenCloseIteration::keptTerms_): about 20,000 contacts; the others' terms
 // are made at every solve.
 constexpr std::size_t kKeptTermsBytes = std::size_t(16) << 20;
 }  // namespace
@@ -80,8 +80,7 @@ void OpenCloseIteration::solveAloneBlocks(const Attempt& attempt) {
 
 void OpenCloseIteration::assembleContacts(const Attempt& attempt) {
 	StepStatistics& stats = attempt.stats;
-	Matrix24 stiffnessWork;
-	Vector24 forceWork;
+	ContactTerms work;
 	const std::vector<Contact>& contacts = attempt.contacts;
 	keptTermsOf_.resize(contacts.size(), -1);
 	keptTermsKey_.resize(contacts.size(), 0);
@@ -99,50 +98,53 @@ void OpenCloseIteration::assembleContacts(const Attempt& attempt) {
 		const bool keepable =
 		    tangential != TangentialTerm::FrictionLoad && !(normalTerms && contact.secantWeight > 0);
 		const unsigned char key = static_cast<unsigned char>(1 + normalTerms + 2 * static_cast<int>(tangential));
-		const Matrix24* stiffnessOf = &stiffnessWork;
-		const Vector24* forceOf = &forceWork;
+		const ContactTerms* termsOf = &work;
 		const int kept = keptTermsOf_[c];
 		if (keepable && kept >= 0 && keptTermsKey_[c] == key) {
-			stiffnessOf = &keptTerms_[kept].stiffness;
-			forceOf = &keptTerms_[kept].force;
+			termsOf = &keptTerms_[kept];
 		} else {
-			contactTerms(contact, attempt.blocks[bi], attempt.blocks[bj], stiffnessWork, forceWork);
+			contactTerms(contact, attempt.blocks[bi], attempt.blocks[bj], work);
 			if (keepTerms_ && keepable &&
-			    (kept >= 0 || (keptTerms_.size() + 1) * sizeof(KeptTerms) <= kKeptTermsBytes)) {
+			    (kept >= 0 || (keptTerms_.size() + 1) * sizeof(ContactTerms) <= kKeptTermsBytes)) {
 				if (kept < 0) {
 					// Grown by hand so that its capacity stays within the budget.
 					if (keptTerms_.size() == keptTerms_.capacity())
 						keptTerms_.reserve(std::min(std::max<std::size_t>(64, 2 * keptTerms_.capacity()),
-						                            kKeptTermsBytes / sizeof(KeptTerms)));
+						                            kKeptTermsBytes / sizeof(ContactTerms)));
 					keptTermsOf_[c] = static_cast<int>(keptTerms_.size());
 					keptTerms_.emplace_back();
 				}
-				KeptTerms& entry = keptTerms_[keptTermsOf_[c]];
-				entry.stiffness = stiffnessWork;
-				entry.force = forceWork;
+				keptTerms_[keptTermsOf_[c]] = work;
 				keptTermsKey_[c] = key;
 			}
 		}
-		const Matrix24& stiffness = *stiffnessOf;
-		const Vector24& force = *forceOf;
+		const ContactTerms& terms = *termsOf;
 		// An open contact may carry its tangential spring alone (its limit is
 		// held for the pass): only closed ones have a normal spring.
 		stats.normalTerms += normalTerms;
 		stats.frictionTerms += tangential != TangentialTerm::None;
 		const int mi = movingIndex_[bi], mj = movingIndex_[bj];
-		if (mi >= 0) {
-			coupled_.diagonal(mi) += stiffness.topLeftCorner<12, 12>();
-			coupled_.force(mi) += force.head<12>();
+		Matrix12* diagonalI = mi >= 0 ? &coupled_.diagonal(mi) : nullptr;
+		Matrix12* diagonalJ = mj >= 0 ? &coupled_.diagonal(mj) : nullptr;
+		bool transposed = false;
+		Matrix12* offDiagonal = mi >= 0 && mj >= 0 ? &coupled_.offDiagonal(mi, mj, transposed) : nullptr;
+		// Each rank-one term w v v^T by its 12x12 blocks: (i, i), (j, j) and
+		// the stored off-diagonal one, (i, j), or (j, i) when transposed.
+		for (int r = 0; r < terms.rank; ++r) {
+			const Vector24 scaled = terms.weight[r] * terms.vector[r];
+			const auto vi = terms.vector[r].head<12>(), vj = terms.vector[r].tail<12>();
+			const auto si = scaled.head<12>(), sj = scaled.tail<12>();
+			if (diagonalI) diagonalI->noalias() += si * vi.transpose();
+			if (diagonalJ) diagonalJ->noalias() += sj * vj.transpose();
+			if (offDiagonal) {
+				if (transposed)
+					offDiagonal->noalias() += sj * vi.transpose();
+				else
+					offDiagonal->noalias() += si * vj.transpose();
+			}
 		}
-		if (mj >= 0) {
-			coupled_.diagonal(mj) += stiffness.bottomRightCorner<12, 12>();
-			coupled_.force(mj) += force.tail<12>();
-		}
-		if (mi >= 0 && mj >= 0) {
-			bool transposed;
-			Matrix12& offDiagonal = coupled_.offDiagonal(mi, mj, transposed);
-			offDiagonal += transposed ? stiffness.bottomLeftCorner<12, 12>() : stiffness.topRightCorner<12, 12>();
-		}
+		if (diagonalI) coupled_.force(mi) += terms.force.head<12>();
+		if (diagonalJ) coupled_.force(mj) += terms.force.tail<12>();
 	}
 }
 
