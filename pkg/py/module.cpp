@@ -275,6 +275,9 @@ py::dict lastStep(const SceneLink& s) {
 	d["stateChanges"] = st.stateChanges;
 	d["normalForceUpdates"] = st.normalForceUpdates;
 	d["lineSearches"] = st.lineSearches;
+	d["refinedComponents"] = st.refinedComponents;
+	d["refineIterations"] = st.refineIterations;
+	d["refineFallbacks"] = st.refineFallbacks;
 	d["limitPasses"] = st.limitPasses;
 	d["limitsUnsettled"] = st.limitsUnsettled;
 	d["settleSteps"] = st.settleSteps;

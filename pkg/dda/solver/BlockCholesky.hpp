@@ -16,8 +16,9 @@
 // Numeric factorisation (right-looking, column by column in elimination
 // order): L_jj = chol(A_jj); L_ij = A_ij L_jj^-T for the rows i of column j;
 // then A_ik -= L_ij L_kj^T for every pair of rows i >= k of column j. The
-// arithmetic is sequential and fixed by the pattern: the same matrix gives
-// bitwise the same factor, whatever the thread count.
+// arithmetic of each block is sequential and fixed by the pattern (a
+// column's rows are shared among threads, each block written by one): the
+// same matrix gives bitwise the same factor, whatever the thread count.
 //
 // Rigid blocks (6 unknowns) keep the 12x12 layout: their strain rows and
 // columns are replaced by those of the identity, with no coupling, and their
@@ -51,6 +52,10 @@ public:
 	void solve(Vector12* x) const;
 
 	int blocks() const { return static_cast<int>(inverse_.size()); }
+	// The factor's off-diagonal 12x12 blocks, and the 12x12 products a
+	// factorisation makes (its cost; a solve costs about twice the blocks).
+	long factorBlocks() const { return static_cast<long>(rows_.size()); }
+	long factorProducts() const { return static_cast<long>(updateTarget_.size() + rows_.size()); }
 	std::size_t memoryBytes() const;
 
 private:
@@ -58,6 +63,7 @@ private:
 	std::vector<int> columnStart_, rows_;  // per column (place), its rows (places) below the diagonal, ascending
 	std::vector<int> linkTarget_;          // per link: its entry of factor_ (signed: -1 - entry when transposed)
 	std::vector<int> updateTarget_;        // per (column j, row i, row k < i of j): the entry of L_ik
+	std::vector<long> updateStart_;        // per column: its first entry of updateTarget_
 	std::vector<int> sizes_;               // per place
 	std::vector<Matrix12> factor_;         // L_ij, per entry of rows_
 	std::vector<Matrix12> diagonal_;       // per place: A_jj, then L_jj

@@ -57,6 +57,10 @@ void subtractProductTransposed(Matrix12& c, const Matrix12& a, const Matrix12& b
 		subtractSse2(c.data(), a.data(), b.data());
 }
 
+void subtractProductTransposedSse2(Matrix12& c, const Matrix12& a, const Matrix12& b) {
+	subtractSse2(c.data(), a.data(), b.data());
+}
+
 void subtractProductTransposedScalar(Matrix12& c, const Matrix12& a, const Matrix12& b) {
 	for (int k = 0; k < 12; ++k)
 		for (int m = 0; m < 12; ++m)

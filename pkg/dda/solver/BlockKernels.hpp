@@ -22,7 +22,9 @@ namespace dda {
 // C -= A B^T.
 void subtractProductTransposed(Matrix12& c, const Matrix12& a, const Matrix12& b);
 
-// The same with the plain scalar loop (the reference the tests compare with).
+// The same by the SSE2 variant whatever the machine has, and by the plain
+// scalar loop (the references the tests compare with).
+void subtractProductTransposedSse2(Matrix12& c, const Matrix12& a, const Matrix12& b);
 void subtractProductTransposedScalar(Matrix12& c, const Matrix12& a, const Matrix12& b);
 
 // Whether subtractProductTransposed runs its AVX2 variant on this machine.

@@ -28,6 +28,26 @@
 // (tests/cpp/solver/test_effects.cpp compares them). Patterns unused for
 // kKeptBuilds builds, or beyond the used patterns' size, are dropped.
 //
+// Later solves of an attempt (refinement). Within one attempt of a step the
+// open-close iteration solves systems that differ only by the terms of the
+// contacts whose state changed (a few rank-one terms each), so a
+// component's matrix stays close to the one factorised at its first solve.
+// When refinement is on (IntegratorSettings::refineSolves) a later solve of a
+// component whose blocks are exactly those of a component factorised earlier
+// in the same attempt runs preconditioned conjugate gradients with that
+// factor, the latest one (refineComponent): with the exact factor of K_old as the
+// preconditioner, the iteration matrix is K_old^-1 K = I + K_old^-1 dK, whose
+// eigenvalues other than 1 are as many as the rank of dK, so it converges in
+// about that many iterations. It stops when the normwise backward error of
+// the true residual, |b - K x| / (|K| |x| + |b|) (infinity norms), is at most
+// kRefineTolerance; a direct Cholesky's is of the order of n times the unit
+// round-off. If it has not converged after as many iterations as cost one
+// factorisation, the component is factorised as before (and that factor
+// preconditions the attempt's later solves). Every attempt starts with
+// factorisations, so a step depends on its start state alone (save and load
+// continue bitwise), and the iteration is sequential within a component, so
+// the result does not depend on the thread count.
+//
 // Rigid blocks have 6 unknowns, not 12. Every block keeps the 12-layout in
 // storage (contact terms are assembled as for any block), but a rigid block's
 // strain unknowns are constrained to zero: alone in its component it is
@@ -92,6 +112,21 @@ public:
 	// Without reuse every solve analyses its components afresh (for tests).
 	void setAnalysisReuse(bool reuse) { reuse_ = reuse; }
 
+	// A new attempt: factors of earlier attempts no longer precondition.
+	// `refine` turns refinement on for the attempt's later solves (above; it
+	// needs analysis reuse, which keeps the factors).
+	void beginAttempt(bool refine) {
+		++attempt_;
+		refine_ = refine;
+		factorByMembers_.clear();
+	}
+	// Components the last solve refined instead of factorising, their
+	// conjugate-gradient iterations, and refinements that did not converge
+	// (and were factorised).
+	int refinedComponents() const { return refinedComponents_; }
+	int refineIterations() const { return refineIterations_; }
+	int refineFallbacks() const { return refineFallbacks_; }
+
 private:
 	struct Analysis;  // a sparse pattern's matrix, value map and analysed factorisation
 	struct AnalysisDeleter {
@@ -110,6 +145,16 @@ private:
 	// `analyse`) and writes its blocks' solutions; false when the
 	// factorisation fails.
 	bool solveComponent(int c, BlockCholesky& cholesky, bool analyse, std::vector<Vector12>& solutions) const;
+	// Solves component c by conjugate gradients preconditioned with
+	// `factor` (of an earlier matrix of the same blocks), at most
+	// `maxIterations` iterations; writes its blocks' solutions and returns
+	// true when converged (`iterations` the count either way).
+	bool refineComponent(int c, const BlockCholesky& factor, int maxIterations, std::vector<Vector12>& solutions,
+	                     int& iterations) const;
+	// The kept analysis holding a factor of this attempt for component c's
+	// blocks that no other component of this build uses, or null.
+	Analysis* preconditionerFor(int c) const;
+	std::size_t membersHash(int c) const;
 
 	std::vector<int> slot_;            // per moving block: its slot, -1 when it has no springs
 	std::vector<int> members_;         // per slot: the moving block
@@ -132,6 +177,11 @@ private:
 	long builds_ = 0;
 	bool reuse_ = true;
 	int reusedAnalyses_ = 0, newAnalyses_ = 0;
+	long attempt_ = 0, solves_ = 0;
+	// This attempt's factors by the hash of their blocks (membersHash).
+	std::unordered_multimap<std::size_t, Analysis*> factorByMembers_;
+	bool refine_ = false;
+	int refinedComponents_ = 0, refineIterations_ = 0, refineFallbacks_ = 0;
 };
 
 }  // namespace dda

@@ -74,6 +74,9 @@ struct StepStatistics {
 	int stateChanges = 0;            // contact state changes in the accepted attempt
 	int normalForceUpdates = 0;      // solves made only because tangential forces had not settled (all attempts)
 	int lineSearches = 0;            // solves whose step was shortened by the line search (all attempts)
+	int refinedComponents = 0;       // components solved by refinement, not factorised (all attempts)
+	int refineIterations = 0;        // their conjugate-gradient iterations (all attempts)
+	int refineFallbacks = 0;         // refinements that did not converge and were factorised (all attempts)
 	int limitPasses = 0;             // passes made after the first because friction limits changed (all attempts)
 	int limitsUnsettled = 0;         // attempts accepted with limits still changing after kLimitPasses passes
 	// start from rest (IntegratorSettings::startFromRest): the settling before the

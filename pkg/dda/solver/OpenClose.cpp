@@ -117,6 +117,7 @@ void OpenCloseIteration::startAttempt(const Attempt& attempt, bool firstStep) {
 	// assembleBlock adds a body force only for non-zero gravity.
 	if (!attempt.settings.gravity.isZero()) attempt.stats.bodyForceBlocks += n;
 	iterate_.assign(n, Vector12::Zero());
+	coupled_.beginAttempt(attempt.settings.refineSolves);
 	keptTerms_.clear();
 	keptTermsOf_.assign(contacts.size(), -1);
 	for (Contact& contact : contacts) {
@@ -156,6 +157,9 @@ void OpenCloseIteration::solveOnce(const Attempt& attempt, bool structureStale) 
 	if (structureStale) solveAloneBlocks(attempt);
 	coupled_.solve(solutions_, kMinBlocksForThreads);
 	stats.solvedUnknowns = coupled_.solvedUnknowns() + aloneUnknowns_;
+	stats.refinedComponents += coupled_.refinedComponents();
+	stats.refineIterations += coupled_.refineIterations();
+	stats.refineFallbacks += coupled_.refineFallbacks();
 	if (lineSearch(attempt) < 1) ++stats.lineSearches;
 	stats.timeSolve += secondsSince(phase);
 }

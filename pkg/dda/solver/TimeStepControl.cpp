@@ -59,8 +59,19 @@ bool TimeStepControl::accept(int attempt, bool converged, double largest, const 
 	return false;
 }
 
-void TimeStepControl::stepTaken(const IntegratorSettings& settings, double dt) {
-	nextTimeStep_ = std::min(settings.maxTimeStep, dt * settings.timeStepGrowth);
+void TimeStepControl::stepTaken(const IntegratorSettings& settings, double dt, double largest, double allowed) {
+	// Grown by timeStepGrowth, but not past the dt at which the accepted
+	// step's motion would reach timeStepSafety x the bound (as a cut would
+	// set it; displacement grows at least linearly with dt). Growing by 1.3
+	// regardless made a block falling at the bound redo every step: each
+	// step tried 1.3 x the dt its cut had found, overshot and was cut again
+	// (the 70-block drop, blocks falling off the trough: every step from
+	// 2.6 s on, each a second factorisation). Only the first dt tried
+	// changes: every accepted step is still one within the bound.
+	double factor = settings.timeStepGrowth;
+	if (largest > 0 && allowed > 0)
+		factor = std::min(factor, std::max(settings.minTimeStepShrink, settings.timeStepSafety * allowed / largest));
+	nextTimeStep_ = std::min(settings.maxTimeStep, dt * factor);
 }
 
 void TimeStepControl::writeState(StateWriter& out) const {

@@ -1,5 +1,6 @@
 // Time-step control of World::step: the dt each step tries first (the last
-// accepted one x timeStepGrowth, at most maxTimeStep), the largest vertex
+// accepted one x timeStepGrowth, less when that step moved near the bound,
+// at most maxTimeStep), the largest vertex
 // displacement a step may make, and the cuts of an attempt that did not
 // converge (dt x openCloseShrink) or moved too far (dt x clamp(safety x
 // allowed / largest, minTimeStepShrink, maxTimeStepShrink)), up to
@@ -64,8 +65,11 @@ public:
 	// when the cuts run out); the cuts are counted in stats.
 	bool accept(int attempt, bool converged, double largest, const StepShrink& volume,
 	            const IntegratorSettings& settings, double& dt, StepStatistics& stats);
-	// The step was taken at dt: the next tries dt x timeStepGrowth.
-	void stepTaken(const IntegratorSettings& settings, double dt);
+	// The step was taken at dt, moving at most `largest` [m] with `allowed`
+	// [m] the bound: the next tries dt x timeStepGrowth, or less if the
+	// step's motion was near the bound (dt x timeStepSafety x allowed /
+	// largest, not below minTimeStepShrink), at most maxTimeStep.
+	void stepTaken(const IntegratorSettings& settings, double dt, double largest, double allowed);
 	// The next step tries dt [s] first (settling's static steps).
 	void setNextTry(double dt) { nextTimeStep_ = dt; }
 	long displacementLimitMisses() const { return displacementLimitMisses_; }

@@ -243,7 +243,7 @@ double World::advance(const IntegratorSettings& settings) {
 	accountStep(settings);
 	moveContactsAndBlocks(settings, dt, stats);
 
-	timeStep_.stepTaken(settings, dt);
+	timeStep_.stepTaken(settings, dt, stats.maxDisplacement, stats.allowedDisplacement);
 	time_ += dt;
 	++steps_;
 	stats.dt = dt;

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 using namespace dda;
@@ -49,6 +50,43 @@ TEST(TimeIntegration, TimeStepIsCutWhenDisplacementExceedsTheBound) {
 	EXPECT_LE(world.lastStep().maxDisplacement, 0.02);
 	EXPECT_NEAR(world.block(b).centroid.x() - 0.5, 10 * dt, 1e-12);
 	EXPECT_THROW({ settings.maxTimeStep = 0; world.step(settings); }, InputError);
+}
+
+// A block falling at the displacement bound: the first dt each step tries
+// follows the last step's motion (TimeStepControl::stepTaken), so steps are
+// not redone one after another (growing dt by 1.3 regardless made every step
+// overshoot and be cut); every step stays within the bound, and the fall is
+// the closed form (exact for any sequence of dt).
+TEST(TimeIntegration, FallingAtTheBoundIsNotRedoneEveryStep) {
+	World world;
+	const int b = world.addBlock(boxPoints(Vector3(0, 0, 0), Vector3(1, 1, 1)), Material{2600, 4e6, 0.25}, false);
+	const Vector3 g(0, 0, -9.81);
+	const Vector3 c0 = world.block(b).centroid;
+	IntegratorSettings settings;
+	settings.gravity = g;
+	settings.maxTimeStep = 0.01;
+	settings.maxDisplacement = 0.002;  // reached at 0.2 m/s, after 2 steps
+	// A redo is expected only while the motion of one step grows by more
+	// than 1 / timeStepSafety over the next: (v + g dt) / v > 1 / 0.9 with
+	// dt = 0.9 a / v, i.e. below v = sqrt(8.1 g a) = 0.4 m/s.
+	double t = 0;
+	int cuts = 0, lateCuts = 0, boundSteps = 0;
+	for (int step = 0; step < 400; ++step) {
+		const double speed = world.block(b).velocity.head<3>().norm();
+		t += world.step(settings);
+		const StepStatistics& s = world.lastStep();
+		cuts += s.stepCuts;
+		if (speed > 0.5) lateCuts += s.stepCuts;
+		boundSteps += s.dt < settings.maxTimeStep;
+		ASSERT_LE(s.maxDisplacement, settings.maxDisplacement) << "step " << step;
+	}
+	std::printf("%d redos in 400 steps, %d above 0.5 m/s; fell to %.2f m/s\n", cuts, lateCuts,
+	            world.block(b).velocity.head<3>().norm());
+	EXPECT_GT(boundSteps, 390);  // the bound decided the steps
+	EXPECT_EQ(lateCuts, 0);      // not one redo per step (the old rule: every step)
+	const Vector3 expected = c0 + 0.5 * g * t * t;
+	EXPECT_LT((world.block(b).centroid - expected).norm(), 1e-10 * expected.norm());
+	EXPECT_LT((world.block(b).velocity.head<3>() - g * t).norm(), 1e-10 * (g * t).norm());
 }
 
 // Finite strain (BlockEquations.hpp): the accepted step's stress update and the
