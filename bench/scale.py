@@ -31,6 +31,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
 import colliders  # noqa: E402  (the slender generator and the detection benchmark)
+import drop  # noqa: E402  (the paper's 70-block drop)
 
 TARGETS = dict(syncShare=0.10, twoThreadRatio=0.6, mscOverYade=1 / 30, candidatesOverPairs=1.5, dropStepsPerSecond=300)
 
@@ -83,17 +84,7 @@ def threadsWorker(n, seed, outDir, rounds):
 
 def dropWorker(rounds, steps):
     """The paper's 70-block drop: 1,500 steps to pile up, then rounds of O.run(steps) on 1 and 2 threads."""
-    yade_dda = _importDDA()
-    from yade import wrapper
-    O = yade_dda.O
-    sys.path.insert(0, os.path.join(ROOT, 'examples', 'paper'))
-    import paper_scenes
-    blocks, mat = paper_scenes.SCENES['hexahedra_drop']()
-    material = O.materials.append(wrapper.PolyhedraMat(**mat))
-    for points, fixed in blocks:
-        O.bodies.append(yade_dda.ddaBlock(points, material=material, fixed=fixed))
-    O.engines = [yade_dda.MSCCollider(label='collider'),
-                 yade_dda.DDAIntegrator(label='dda', gravity=(0, 0, -9.81), threads=1, **paper_scenes.STEP)]
+    O, yade_dda = drop.build(threads=1, refine=None)
     O.run(1500, True)
     rates = {1: [], 2: []}
     for _ in range(rounds):

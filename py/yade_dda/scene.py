@@ -303,6 +303,10 @@ def stats():
     ``maxPenetration`` [m] (deepest closed contact), ``components`` and
     ``largestComponent`` (independent systems solved, blocks in the largest),
     ``lineSearches`` (solves whose step a line search shortened),
+    ``refinedComponents``, ``refineIterations`` and ``refineFallbacks``
+    (later solves of a step done by conjugate gradients preconditioned with
+    the step's first factorisation, their iterations, and those that fell
+    back to a factorisation; DDAIntegrator's refineSolves),
     ``limitPasses`` and ``limitsUnsettled`` (friction-limit passes after the
     first; groups of touching blocks accepted with limits still moving).
     ``settleSteps``, ``settledBlocks``, ``settleConverged``: the start from

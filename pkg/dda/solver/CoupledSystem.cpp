@@ -40,10 +40,14 @@ constexpr long kKeptBuilds = 16;
 // iterations it may take, a cap on its cost-based budget.
 constexpr double kRefineTolerance = 1e-14;
 constexpr int kMaxRefineIterations = 100;
+// Components of fewer blocks are always factorised: their factorisation
+// costs a few iterations (12 blocks at half density: 7).
+constexpr int kMinRefineBlocks = 8;
 
-std::size_t patternHash(const std::vector<int>& pattern) {
+template <class Iterator>
+std::size_t patternHash(Iterator first, Iterator last) {
 	std::size_t h = 1469598103934665603ull;
-	for (int v : pattern) h = (h ^ static_cast<std::size_t>(static_cast<unsigned>(v))) * 1099511628211ull;
+	for (; first != last; ++first) h = (h ^ static_cast<std::size_t>(static_cast<unsigned>(*first))) * 1099511628211ull;
 	return h;
 }
 
@@ -137,7 +141,7 @@ void CoupledSystem::keepAnalyses() {
 			pattern.push_back(linkSlots_[l].first - first);
 			pattern.push_back(linkSlots_[l].second - first);
 		}
-		const std::size_t hash = patternHash(pattern);
+		const std::size_t hash = patternHash(pattern.begin(), pattern.end());
 		componentHash_[c] = hash;
 		Analysis* found = nullptr;
 		for (auto [it, end] = analysisByHash_.equal_range(hash); it != end; ++it) {
@@ -278,7 +282,7 @@ CoupledSystem::Analysis* CoupledSystem::preconditionerFor(int c) const {
 }
 
 std::size_t CoupledSystem::membersHash(int c) const {
-	return patternHash(std::vector<int>(members_.begin() + componentStart_[c], members_.begin() + componentStart_[c + 1]));
+	return patternHash(members_.begin() + componentStart_[c], members_.begin() + componentStart_[c + 1]);
 }
 
 bool CoupledSystem::refineComponent(int c, const BlockCholesky& factor, int maxIterations,
@@ -387,7 +391,7 @@ void CoupledSystem::solve(std::vector<Vector12>& solutions, int threadsFrom) {
 	std::vector<char> factored(count, 0);
 	if (refine_ && reuse_)
 		for (int c = 0; c < count; ++c)
-			if (componentStart_[c + 1] - componentStart_[c] > 1) preconditioner[c] = preconditionerFor(c);
+			if (componentStart_[c + 1] - componentStart_[c] >= kMinRefineBlocks) preconditioner[c] = preconditionerFor(c);
 #pragma omp parallel for schedule(dynamic) \
     reduction(+ : solved, reusedAnalyses, newAnalyses, refined, refineIterations, fallbacks) if (count >= threadsFrom)
 	for (int c = 0; c < count; ++c) {
@@ -454,7 +458,7 @@ void CoupledSystem::solve(std::vector<Vector12>& solutions, int threadsFrom) {
 	refineFallbacks_ = fallbacks;
 	// The factors made now precondition the attempt's later solves of the same blocks.
 	for (int c = 0; c < count; ++c) {
-		if (!factored[c]) continue;
+		if (!factored[c] || !refine_ || componentStart_[c + 1] - componentStart_[c] < kMinRefineBlocks) continue;
 		Analysis* a = componentAnalysis_[c];
 		a->factoredMembers.assign(members_.begin() + componentStart_[c], members_.begin() + componentStart_[c + 1]);
 		a->membersHash = membersHash(c);
