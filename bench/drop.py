@@ -2,14 +2,15 @@
 
 The drop's cost depends on the state of its pile (the logs land, pile up in the V-shaped trough, rebound,
 then slide off its open ends and fall), so one rate says little: this runs the scene from the start in
-chunks of ``--chunk`` steps (``O.step()``; the bodies are synced only when something reads them, as in
-``O.run``) and records per chunk its steps per second, simulated time, the step's phases (ms per step),
-the open-close solves, refinements and step cuts, and the contact pairs and largest coupled component.
-Issue 21's target is 300 steps/s once piled up.
+chunks of ``--chunk`` steps of ``O.run`` (as a script runs it) and records each chunk's steps per second;
+then runs it again, the same trajectory, with a PyRunner summing every step's stats (its rates are not
+the scene's: reading stats syncs YADE's bodies every step) for each chunk's simulated time, the step's
+phases (ms per step), the open-close solves, refinements and step cuts, the contact pairs and the
+largest coupled component. Issue 21's target is 300 steps/s once piled up.
 
 Writes bench/out/drop.json (``--out``) and prints one line per chunk. Run:
 YADE_DDA_BUILD=<build>/py /usr/bin/python3 bench/drop.py [--chunks 12] [--chunk 300] [--threads 1]
-(about a minute). With ``--threads 2`` both cores must be free (bench/scale.py's note).
+(a minute or two). With ``--threads 2`` both cores must be free (bench/scale.py's note).
 """
 import argparse
 import json
@@ -42,29 +43,61 @@ def build(threads, refine):
     return O, yade_dda
 
 
-def chunk(O, yade_dda, steps):
-    """Runs `steps` steps; returns the chunk's record."""
-    phases = dict.fromkeys(PHASES, 0.0)
-    counts = dict(solves=0, refined=0, refineIterations=0, refineFallbacks=0, stepCuts=0)
-    largest = 0
-    t0, wall = O.time, time.perf_counter()
-    for _ in range(steps):
-        O.step()
-        s = yade_dda.stats()
+class Totals:
+    """Sums each step's phases and counts; a PyRunner calls add() after every DDA step."""
+
+    def __init__(self, yade_dda):
+        self.yade_dda = yade_dda
+        self.reset()
+
+    def reset(self):
+        self.phases = dict.fromkeys(PHASES, 0.0)
+        self.counts = dict(solves=0, refined=0, refineIterations=0, refineFallbacks=0, stepCuts=0)
+        self.largest = 0
+
+    def add(self):
+        s = self.yade_dda.stats()
         for k in PHASES:
-            phases[k] += s['time'].get(k, 0.0)
-        counts['solves'] += s['openCloseIterationsTotal']
-        counts['refined'] += s.get('refinedComponents', 0)
-        counts['refineIterations'] += s.get('refineIterations', 0)
-        counts['refineFallbacks'] += s.get('refineFallbacks', 0)
-        counts['stepCuts'] += s['stepCuts']
-        largest = max(largest, s['largestComponent'])
-    wall = time.perf_counter() - wall
-    s = yade_dda.stats()
-    return dict(stepsPerSecond=steps / wall, simulatedTime=[t0, O.time],
-                msPerStep={k: 1e3 * v / steps for k, v in phases.items()},
-                solvesPerStep=counts['solves'] / steps, counts=counts, largestComponent=largest,
-                contactPairs=s['contactPairs'], closedContacts=s['closedContacts'])
+            self.phases[k] += s['time'].get(k, 0.0)
+        self.counts['solves'] += s['openCloseIterationsTotal']
+        self.counts['refined'] += s.get('refinedComponents', 0)
+        self.counts['refineIterations'] += s.get('refineIterations', 0)
+        self.counts['refineFallbacks'] += s.get('refineFallbacks', 0)
+        self.counts['stepCuts'] += s['stepCuts']
+        self.largest = max(self.largest, s['largestComponent'])
+
+
+def rates(threads, refine, chunks, steps):
+    """Steps per second of each chunk of O.run(steps) (nothing reads the bodies, so they are synced once a chunk)."""
+    O, yade_dda = build(threads, refine)
+    out = []
+    for _ in range(chunks):
+        wall = time.perf_counter()
+        O.run(steps, True)
+        out.append(steps / (time.perf_counter() - wall))
+    return out
+
+
+def details(threads, refine, chunks, steps):
+    """The same run again with a PyRunner summing each step's stats (which syncs the bodies every step, so
+    its rates are not the scene's): per chunk the phases, counts, pairs and simulated time."""
+    O, yade_dda = build(threads, refine)
+    from yade import wrapper
+    import __main__
+    totals = Totals(yade_dda)
+    __main__.dropBenchTotals = totals
+    O.engines = O.engines + [wrapper.PyRunner(iterPeriod=1, command='dropBenchTotals.add()')]
+    out = []
+    for _ in range(chunks):
+        totals.reset()
+        t0 = O.time
+        O.run(steps, True)
+        s = yade_dda.stats()
+        out.append(dict(simulatedTime=[t0, O.time], msPerStep={k: 1e3 * v / steps for k, v in totals.phases.items()},
+                        solvesPerStep=totals.counts['solves'] / steps, counts=dict(totals.counts),
+                        largestComponent=totals.largest, contactPairs=s['contactPairs'],
+                        closedContacts=s['closedContacts']))
+    return out
 
 
 def main():
@@ -77,19 +110,19 @@ def main():
     parser.add_argument('--out', default=os.path.join(HERE, 'out', 'drop.json'))
     args = parser.parse_args()
     refine = None if args.refine == 'default' else args.refine == 'on'
-    O, yade_dda = build(args.threads, refine)
-    rows = []
-    for k in range(args.chunks):
-        row = chunk(O, yade_dda, args.chunk)
-        row['steps'] = [k * args.chunk, (k + 1) * args.chunk]
-        rows.append(row)
+    rows = [dict(steps=[k * args.chunk, (k + 1) * args.chunk], stepsPerSecond=r)
+            for k, r in enumerate(rates(args.threads, refine, args.chunks, args.chunk))]
+    O = sys.modules['yade_dda'].O
+    O.reset()
+    for row, more in zip(rows, details(args.threads, refine, args.chunks, args.chunk)):
+        row.update(more)
         ms = row['msPerStep']
         print('steps %5d-%5d  t %.3f-%.3f s  %6.1f steps/s  solves/step %.2f  cuts %d  refined %d  pairs %d  '
-              'component %d  narrow %.2f  assembly %.2f  solve %.2f  core %.2f  sync %.2f ms'
+              'component %d  narrow %.2f  assembly %.2f  solve %.2f  core %.2f ms'
               % (row['steps'][0], row['steps'][1], row['simulatedTime'][0], row['simulatedTime'][1],
                  row['stepsPerSecond'], row['solvesPerStep'], row['counts']['stepCuts'], row['counts']['refined'],
                  row['contactPairs'], row['largestComponent'], ms['narrowPhase'], ms['assembly'], ms['solve'],
-                 ms['core'], ms['sync']), flush=True)
+                 ms['core']), flush=True)
     os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
     with open(args.out, 'w') as f:
         json.dump(dict(scene='hexahedra_drop', threads=args.threads, chunk=args.chunk, refine=args.refine,
