@@ -15,8 +15,13 @@ namespace dda {
 namespace {
 
 // A column's 12x12 products (about 0.16 us each with AVX2) below which its
-// updates run on one thread: a parallel region costs a few microseconds.
-constexpr long kMinProductsForThreads = 96;
+// updates run on one thread: about 80 us of work. A parallel region costs a
+// few microseconds on free cores, but on a loaded machine each one can wait
+// a scheduler slice for a descheduled thread (a dense 66-block factorisation
+// with a region for every column of 96 products or more: 6.7 ms on 2 threads
+// against 9.8 on one, and 184 ms once with the other core busy), so only
+// long columns get one.
+constexpr long kMinProductsForThreads = 512;
 
 // The entry of row `row` in column `column`'s sorted rows.
 int entryOf(const std::vector<int>& columnStart, const std::vector<int>& rows, int column, int row) {
