@@ -114,7 +114,7 @@ def test_a_tunnel_in_concave_blocks_keeps_its_account_and_its_loose_block_falls_
     """A 16 m x 8 m x 16 m box around a 4 m x 4 m tunnel, given as four convex parts, cut by two
     conjugate sets dipping 60 degrees and a horizontal set of persistence 0.6, joined into concave blocks
     (seed 4); the boundary blocks held, E = 1e10 Pa, 30 degrees of friction, gravity, 0.3 s. The energy
-    account balances (1e-6 of the largest change) and what contact detection adds stays within 1e-3 of it; the
+    account balances (1e-6 of the largest change) and what contact detection adds stays within 1e-4 of it; the
     block that falls
     farthest, concave, falls freely: its drop fits g t^2 / 2 (1 %)."""
     parts = [box((0, 0, 0), (16, 8, 6)), box((0, 0, 10), (16, 8, 16)), box((0, 0, 6), (6, 8, 10)),
@@ -149,13 +149,14 @@ def test_a_tunnel_in_concave_blocks_keeps_its_account_and_its_loose_block_falls_
                          - e['loads'] - e['contactChanges'])
     scale = max(abs(e[k] - e0[k]) for k in e)
     assert abs(account(e) - account(e0)) < 1e-6 * scale
-    # What detection gives the springs stays within the suite's bound (1e-3 of the largest change, as the
-    # energy tests of the solver take it): measured +114 J of 2.3e5 (5e-4). Most of it comes in bursts
-    # where a pair's entrance switches sides and a corner that was inside the other block without a
-    # contact is found 14 um deep (no history to take over): open, see doc/testing.md.
+    # What detection gives the springs stays within 1e-4 of the largest change. The bursts it had came from
+    # corners given a negative gap against a face whose plane runs on past a ridge of a concave block,
+    # the corners outside the whole block: 78 J in one step (refineSolves off; +114 J over the run on an
+    # older solver), until ownEntranceContact bounded those gaps by the pair's penetration (SubContacts.cpp).
+    # Now -74 J of 2.3e5 (energy lost; -37 J with refineSolves off, no step above 1 J).
     changes = e['contactChanges'] - e0['contactChanges']
     print('contact changes %.4g J, largest change %.4g J' % (changes, scale))
-    assert changes <= 1e-3 * scale
+    assert changes <= 1e-4 * scale
     fallen = max(free, key=lambda i: track[i][-1])
     # Its first steps it shares with free neighbours that fall too and part from it; from 0.05 s on it
     # touches nothing: its drop is a parabola of curvature g.

@@ -1,0 +1,333 @@
+// Contact coverage: every corner that lies inside another block has a contact,
+// and a contact found with no history is no deeper than the step's motion can
+// explain. Oracle: the signed distance of a corner to the other convex part,
+// max over that part's face planes (Newell normals of its own corners),
+// computed here directly from the start-of-step corners, not by the narrow
+// phase. Scenes: random piles of L's, T's and cubes turned at random (seed
+// printed), as concave blocks and, for comparison, with every part a convex
+// block of its own.
+//
+// Why it is physics: a penalty contact pushes only where a contact exists; a
+// corner inside the other block with no contact of its own meets no force
+// until some later detection finds it, already deep, and a new contact has no
+// history to take over (its spring starts stretched): the energy account
+// books it in contactChanges. A corner outside both blocks at one step can
+// enter the other by at most the two blocks' relative motion in the next
+// step, so a new contact deeper than that was inside without a contact.
+#include "TestScenes.hpp"
+#include "dda/collider/ColliderFactory.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <map>
+#include <random>
+
+namespace dda::testing {
+namespace {
+
+// A part's face planes at the start of a step: outward Newell normals through
+// the mean of each face's corners.
+struct PartPlanes {
+	std::vector<Vector3> normals, points;
+	std::vector<char> internal;  // shared whole with another part of its body
+};
+
+PartPlanes planesOf(const Block& block) {
+	PartPlanes p;
+	for (const std::vector<int>& face : block.shape->faces) {
+		Vector3 n = Vector3::Zero(), c = Vector3::Zero();
+		for (std::size_t k = 0; k < face.size(); ++k) {
+			const Vector3& a = block.vertices[face[k]];
+			const Vector3& b = block.vertices[face[(k + 1) % face.size()]];
+			n += a.cross(b);
+			c += a;
+		}
+		p.normals.push_back(n.normalized());
+		p.points.push_back(c / static_cast<double>(face.size()));
+	}
+	p.internal.assign(p.normals.size(), 0);
+	return p;
+}
+
+// Signed distance [m] of x from the convex part: max over its face planes
+// (exact inside, a lower bound of the distance outside); `nearest` the face
+// that gives it.
+double signedDistance(const PartPlanes& p, const Vector3& x, int* nearest = nullptr) {
+	double best = -std::numeric_limits<double>::infinity();
+	for (std::size_t g = 0; g < p.normals.size(); ++g) {
+		const double d = p.normals[g].dot(x - p.points[g]);
+		if (d > best) {
+			best = d;
+			if (nearest) *nearest = static_cast<int>(g);
+		}
+	}
+	return best;
+}
+
+double diagonal(const std::vector<Vector3>& corners) {
+	Eigen::AlignedBox3d box;
+	for (const Vector3& x : corners) box.extend(x);
+	return box.diagonal().norm();
+}
+
+int bodyOf(const World& world, int part) {
+	const Block& b = world.block(part);
+	return b.body >= 0 ? b.body : part;
+}
+
+// The pile of test_concave_blocks.cpp (a floor, 12 L's, T's and cubes turned
+// at random, 2 x 2 per layer), with Young's modulus `young`; `concave` false
+// adds every part of an L or T as a convex block of its own. `roofs` puts
+// roofs in place of the L's: two parallelepipeds 1 m x 1 m x 0.5 m sharing
+// their seam face, each sheared down by 0.2 m away from it, so the top faces
+// meet at a ridge (11 degrees) and the bottom ones in a valley: a face's
+// plane runs on past the ridge above the other part, outside the block.
+World randomPile(unsigned seed, bool concave, double young, bool roofs = false) {
+	std::mt19937 rng(seed);
+	std::uniform_real_distribution<double> unit(0, 1);
+	World world;
+	Material rock{2600, young, 0.25};
+	rock.frictionAngle = 0.4;
+	world.addBlock(orientedBox(Vector3(4, 4, -0.5), Vector3(8, 8, 0.5), Matrix3::Identity()), rock, true);
+	for (int k = 0; k < 12; ++k) {
+		const Vector3 centre(2 + 4 * (k % 2) + 0.3 * unit(rng), 2 + 4 * (k / 2 % 2) + 0.3 * unit(rng),
+		                     2 + 3.6 * (k / 4) + 0.3 * unit(rng));
+		const Matrix3 R = k % 3 == 2 ? Matrix3(Eigen::AngleAxisd(6.3 * unit(rng), Vector3::UnitZ()).toRotationMatrix())
+		                             : Matrix3(randomRotation(rng));
+		if (k % 3 == 2) {
+			world.addBlock(orientedBox(centre, Vector3(0.5, 0.5, 0.5), R), rock, false);
+			continue;
+		}
+		if (roofs && k % 3 == 0) {
+			std::vector<std::vector<Vector3>> parts;
+			for (const double side : {-1.0, 1.0}) {
+				std::vector<Vector3> corners;
+				for (const double x : {0.0, side})
+					for (const double y : {-0.5, 0.5})
+						for (const double z : {-0.25, 0.25}) corners.push_back(centre + R * Vector3(x, y, z - 0.2 * std::abs(x)));
+				parts.push_back(corners);
+			}
+			world.addConcaveBlock(parts, rock, false, false);
+			continue;
+		}
+		std::vector<Vector3> offsets = {Vector3(0, 0, 0), Vector3(1, 0, 0), Vector3(0, 1, 0)};
+		if (k % 3 == 1) offsets.push_back(Vector3(-1, 0, 0));
+		std::vector<std::vector<Vector3>> parts;
+		for (const Vector3& o : offsets) {
+			std::vector<Vector3> corners = boxPoints(o - Vector3(0.5, 0.5, 0.5), o + Vector3(0.5, 0.5, 0.5));
+			for (Vector3& x : corners) x = centre + R * x;
+			parts.push_back(corners);
+		}
+		if (concave)
+			world.addConcaveBlock(parts, rock, false, k % 2 == 0);
+		else
+			for (const auto& part : parts) world.addBlock(part, rock, false, k % 2 == 0);
+	}
+	world.setCollider(makeCollider("DESS"));
+	return world;
+}
+
+// What the oracle counts over a run.
+struct Coverage {
+	long insideCorners = 0;        // corner-in-part instances deeper than the tolerance
+	long uncovered = 0;            // of those, no contact of that corner with the other body
+	long uncoveredPairless = 0;    // of those, no contact at all between the two parts
+	long uncoveredOtherSide = 0;   // the pair's contacts all of the other part's corners
+	long uncoveredAtInternal = 0;  // the corner's nearest face of the other part is internal
+	long merged = 0;               // covered only by a contact point within the corner merge distance
+	double deepestUncovered = 0;   // [m]
+	std::string deepestWhere;
+	long newContacts = 0, newDeep = 0;  // new VF contacts; deeper than the step's motion allows
+	double deepestNew = 0, deepestNewRatio = 0;  // [m]; depth / (2 x previous step's largest displacement)
+	std::string deepestNewWhere;
+	// Vertex-face contacts with a gap below -tolerance whose corner lies
+	// outside every part of the face's block by more than the tolerance: a
+	// gap that measures no overlap (a ghost).
+	long ghosts = 0;
+	double deepestGhost = 0;  // [m], its gap
+	std::string deepestGhostWhere;
+	std::map<std::string, long> uncoveredByType;  // pair's structural type of the uncovered corners
+	double d0 = 0;
+};
+
+// Steps the pile and checks, at every step, the start-of-step corners
+// against the contacts detected from them.
+Coverage measure(World& world, int steps, double tolerance) {
+	IntegratorSettings settings;
+	settings.gravity = Vector3(0, 0, -9.81);
+	settings.maxTimeStep = 2e-3;
+	settings.threads = 1;
+	settings.newmarkGamma = 0.5;
+	settings.newmarkBeta = 0.25;
+	Coverage result;
+	const int n = world.blockCount();
+	// Each part's largest corner displacement in the last step [m].
+	std::vector<double> lastMotion(n, 0.0);
+	for (int step = 0; step < steps; ++step) {
+		std::vector<PartPlanes> planes;
+		std::vector<std::vector<Vector3>> corners;
+		for (int i = 0; i < n; ++i) {
+			planes.push_back(planesOf(world.block(i)));
+			corners.push_back(world.block(i).vertices);
+		}
+		// A part's face is internal when a face of another part of its body
+		// has the opposite normal through the same centroid.
+		for (int i = 0; i < n; ++i)
+			for (int j = 0; j < n; ++j) {
+				if (i == j || bodyOf(world, i) != bodyOf(world, j) || !world.block(i).isPart()) continue;
+				for (std::size_t f = 0; f < planes[i].points.size(); ++f)
+					for (std::size_t g = 0; g < planes[j].points.size(); ++g)
+						if ((planes[i].points[f] - planes[j].points[g]).norm() < 1e-9 &&
+						    planes[i].normals[f].dot(planes[j].normals[g]) < -0.999)
+							planes[i].internal[f] = 1;
+			}
+		world.step(settings);
+		const StepStatistics& stats = world.lastStep();
+		result.d0 = stats.contactDistance;
+		// Corners with a contact: (part, vertex, other body); parts with a contact.
+		std::set<std::tuple<int, int, int>> vertexCovered;
+		std::map<std::pair<int, int>, std::vector<Vector3>> pairPoints;  // (P, body of Q): contact points
+		std::map<std::pair<int, int>, std::pair<int, int>> pairSides;  // (P, Q) -> (P's corners, Q's corners)
+		std::map<std::pair<int, int>, std::string> pairType;
+		for (const Contact& c : world.contacts()) {
+			const int i = c.key.blockI, j = c.key.blockJ;
+			pairType[{std::min(i, j), std::max(i, j)}] = contactTypeName(c.pairType);
+			for (const Vector3& x : {c.geometry.pointI, c.geometry.pointJ}) {
+				pairPoints[{i, bodyOf(world, j)}].push_back(x);
+				pairPoints[{j, bodyOf(world, i)}].push_back(x);
+			}
+			if (c.key.kind == ContactKind::VertexFace) {
+				vertexCovered.emplace(i, c.key.feature1, bodyOf(world, j));
+				auto& sides = pairSides[{i, j}];
+				++sides.first;
+				++pairSides[{j, i}].second;
+			} else {
+				for (int v : world.block(i).shape->edges[c.key.feature1]) vertexCovered.emplace(i, v, bodyOf(world, j));
+				for (int v : world.block(j).shape->edges[c.key.feature2]) vertexCovered.emplace(j, v, bodyOf(world, i));
+				pairSides[{i, j}];
+				pairSides[{j, i}];
+			}
+		}
+		for (int p = 0; p < n; ++p)
+			for (int q = 0; q < n; ++q) {
+				if (p == q || bodyOf(world, p) == bodyOf(world, q)) continue;
+				if (world.block(p).fixed && world.block(q).fixed) continue;
+				for (int v = 0; v < static_cast<int>(corners[p].size()); ++v) {
+					int nearest = -1;
+					const double sd = signedDistance(planes[q], corners[p][v], &nearest);
+					if (!(sd < -tolerance)) continue;
+					++result.insideCorners;
+					if (vertexCovered.count({p, v, bodyOf(world, q)})) continue;
+					// Corners closer than the merge distance make one contact point
+					// (1e-3 of the smaller block's diagonal, ContactDetection.cpp).
+					const double merge = 1e-3 * std::min(diagonal(corners[p]), diagonal(corners[q]));
+					const auto points = pairPoints.find({p, bodyOf(world, q)});
+					if (points != pairPoints.end() &&
+					    std::any_of(points->second.begin(), points->second.end(),
+					                [&](const Vector3& x) { return (x - corners[p][v]).norm() <= merge; })) {
+						++result.merged;
+						continue;
+					}
+					++result.uncovered;
+					const auto sides = pairSides.find({p, q});
+					if (sides == pairSides.end()) ++result.uncoveredPairless;
+					else if (sides->second.first == 0 && sides->second.second > 0) ++result.uncoveredOtherSide;
+					if (planes[q].internal[nearest]) ++result.uncoveredAtInternal;
+					const auto type = pairType.find({std::min(p, q), std::max(p, q)});
+					++result.uncoveredByType[type == pairType.end() ? "none" : type->second];
+					if (-sd > result.deepestUncovered) {
+						result.deepestUncovered = -sd;
+						char where[200];
+						std::snprintf(where, sizeof where, "step %d: corner %d of part %d in part %d%s, type %s",
+						              step, v, p, q, planes[q].internal[nearest] ? " (nearest face internal)" : "",
+						              type == pairType.end() ? "none" : type->second.c_str());
+						result.deepestWhere = where;
+					}
+				}
+			}
+		for (const Contact& c : world.contacts()) {
+			if (c.key.kind != ContactKind::VertexFace || !(c.geometry.gap < -tolerance)) continue;
+			const Vector3& x = corners[c.key.blockI][c.key.feature1];
+			double outside = std::numeric_limits<double>::infinity();  // over the face's block's parts
+			for (int m = 0; m < n; ++m)
+				if (bodyOf(world, m) == bodyOf(world, c.key.blockJ))
+					outside = std::min(outside, signedDistance(planes[m], x));
+			if (!(outside > tolerance)) continue;
+			++result.ghosts;
+			if (-c.geometry.gap > result.deepestGhost) {
+				result.deepestGhost = -c.geometry.gap;
+				char where[200];
+				std::snprintf(where, sizeof where, "step %d: corner %d of part %d on face %d of part %d, %.3g m outside",
+				              step, c.key.feature1, c.key.blockI, c.key.feature2, c.key.blockJ, outside);
+				result.deepestGhostWhere = where;
+			}
+		}
+		for (const Contact& c : world.contacts()) {
+			if (!c.isNew || c.key.kind != ContactKind::VertexFace) continue;
+			++result.newContacts;
+			const double depth = -signedDistance(planes[c.key.blockJ], corners[c.key.blockI][c.key.feature1]);
+			if (!(depth > tolerance)) continue;
+			// The corner and the face's part each moved at most this much.
+			const double motion = lastMotion[c.key.blockI] + lastMotion[c.key.blockJ];
+			const double ratio = depth / std::max(motion, 1e-300);
+			if (ratio > 1) ++result.newDeep;
+			if (depth > result.deepestNew) {
+				result.deepestNew = depth;
+				result.deepestNewRatio = ratio;
+				char where[200];
+				std::snprintf(where, sizeof where, "step %d: corner %d of part %d in part %d, gap %.3g, type %s", step,
+				              c.key.feature1, c.key.blockI, c.key.blockJ, c.geometry.gap,
+				              contactTypeName(c.pairType));
+				result.deepestNewWhere = where;
+			}
+		}
+		for (int i = 0; i < n; ++i) {
+			lastMotion[i] = 0;
+			for (std::size_t v = 0; v < corners[i].size(); ++v)
+				lastMotion[i] = std::max(lastMotion[i], (world.block(i).vertices[v] - corners[i][v]).norm());
+		}
+	}
+	return result;
+}
+
+void print(const char* name, unsigned seed, const Coverage& c) {
+	std::printf("%s seed %u (d0 %.3g m): %ld corner instances inside, %ld without a contact of their own (%ld with none in "
+	            "the pair, %ld where the pair's contacts are the other part's corners, %ld nearest an internal face; %ld more merged with a contact point), "
+	            "deepest %.3g m [%s]; %ld new vertex contacts, %ld deeper than the two parts' last step's motion, deepest "
+	            "%.3g m (%.3g x) [%s]\n",
+	            name, seed, c.d0, c.insideCorners, c.uncovered, c.uncoveredPairless, c.uncoveredOtherSide,
+	            c.uncoveredAtInternal, c.merged, c.deepestUncovered, c.deepestWhere.c_str(), c.newContacts, c.newDeep,
+	            c.deepestNew, c.deepestNewRatio, c.deepestNewWhere.c_str());
+	std::printf("  %ld vertex contacts with a negative gap for a corner outside the face's block, deepest gap %.3g m [%s]\n",
+	            c.ghosts, -c.deepestGhost, c.deepestGhostWhere.c_str());
+	for (const auto& [type, count] : c.uncoveredByType) std::printf("  uncovered in pairs of type %s: %ld\n", type.c_str(), count);
+}
+
+TEST(ContactCoverage, CornersInsideAnotherBlockHaveContacts) {
+	const char* env = std::getenv("DDA_COVERAGE_SEEDS");
+	std::vector<unsigned> seeds = {3, 17};
+	if (env) {
+		seeds.clear();
+		for (unsigned s = 1; s <= static_cast<unsigned>(std::atoi(env)); ++s) seeds.push_back(s);
+	}
+	for (const unsigned seed : seeds)
+		for (const int kind : {0, 1, 2})  // concave, convex, roofs
+			for (const double young : {1e8, 1e10}) {
+				World world = randomPile(seed, kind != 1, young, kind == 2);
+				const Coverage c = measure(world, 700, 2e-6);
+				char name[64];
+				std::snprintf(name, sizeof name, "%s E=%.0e", kind == 0 ? "concave" : kind == 1 ? "convex" : "roofs",
+				              young);
+				print(name, seed, c);
+				EXPECT_EQ(c.uncovered, 0) << name << " seed " << seed << ": " << c.deepestWhere;
+				EXPECT_EQ(c.newDeep, 0) << name << " seed " << seed << ": " << c.deepestNewWhere;
+				// Reported, not asserted: the narrow phase allows a corner outside
+				// the other block a gap down to minus the pair's penetration
+				// (SubContacts.cpp), which this count does not know; the roofs'
+				// deepest (-0.09 m, seed 3, E 1e8) is open.
+			}
+}
+
+}  // namespace
+}  // namespace dda::testing
