@@ -165,17 +165,6 @@ py::list contactGaps(const SceneLink& s) {
 	return out;
 }
 
-// Each sub-contact's identity as contacts() lists them: (block i, block j,
-// "VF" or "EE", feature of i, feature of j, new), new when it took over no
-// history this step; what a check of which corners have contacts needs.
-py::list contactFeatures(const SceneLink& s) {
-	py::list out;
-	for (const Contact& c : s.world.contacts())
-		out.append(py::make_tuple(c.key.blockI, c.key.blockJ, c.key.kind == ContactKind::VertexFace ? "VF" : "EE",
-		                          c.key.feature1, c.key.feature2, c.isNew));
-	return out;
-}
-
 // The narrow phase of one pair of blocks at their current geometry, as the
 // integrator would see it with contact distance d0 [m]: None when farther
 // apart, else (structural type, entrance normal, [(kind, i owns, feature of
@@ -497,8 +486,6 @@ void registerScene() {
 	          py::arg("cohesion"), py::arg("tensileStrength"), py::arg("fixed"), py::arg("rigid") = false))
 	    .def("contacts", &contactList)
 	    .def("contactGaps", &contactGaps, "Gap [m] at the start of the last step of each sub-contact, as in contacts().")
-	    .def("contactFeatures", &contactFeatures,
-	         "(block i, block j, kind, feature of i, feature of j, new) of each sub-contact, as in contacts().")
 	    .def("setCollider", &setCollider)
 	    .def("setCover", &setCover)
 	    .def("detectPair", &detectPair)
