@@ -164,6 +164,7 @@ void ContactDetection::startChunks(const std::vector<Block>& blocks) {
 	pairFound_.resize(chunkCapacity);
 	pairWork_.resize(chunkCapacity);
 	pairArea_.resize(chunkCapacity);
+	pairFirst_.resize(chunkCapacity);
 }
 
 void ContactDetection::claimPlanes(int begin, int next) {
@@ -201,9 +202,12 @@ void ContactDetection::detectChunk(Step& step, int begin, int count, int chunk) 
 	const int next = begin + count;
 	claimPlanes(begin, next);
 	const int planeCount = static_cast<int>(planeBlocks_.size());
-	// One team for both loops: the barrier after the first completes the
-	// planes before any pair reads them, the region's end waits for the
-	// pairs (nowait: no barrier of its own).
+	int firstContact = 0;
+	long friction = 0;
+	// One team for the chunk: the planes (the barrier after them completes
+	// them before any pair reads them), the pairs, the store's intake (one
+	// thread: it sets where each pair's contacts go, in pair order, as they
+	// would go without chunks) and the contacts' filling and preparation.
 #pragma omp parallel if (step.threads)
 	{
 #pragma omp for schedule(dynamic, 32)
@@ -211,7 +215,7 @@ void ContactDetection::detectChunk(Step& step, int begin, int count, int chunk) 
 			const Block& block = blocks[planeBlocks_[k]];
 			planes_[planeSlot_[planeBlocks_[k]]].compute(*block.shape, block.vertices);
 		}
-#pragma omp for schedule(dynamic, 16) nowait
+#pragma omp for schedule(dynamic, 16)
 		for (int q = 0; q < count; ++q) {
 			const auto [a, b] = pairs_[begin + q];
 			const Block& A = blocks[a];
@@ -238,20 +242,35 @@ void ContactDetection::detectChunk(Step& step, int begin, int count, int chunk) 
 			                    std::min(A.material.tensileStrength, B.material.tensileStrength) > 0;
 			if (pairFound_[q]) pairArea_[q] = bonded ? contactArea(pairResults_[q]) : 0.0;
 		}
+#pragma omp single
+		{
+			releasePlanes(begin, next, chunk);
+			firstContact = takeChunk(step, begin, count);
+		}
+#pragma omp for schedule(dynamic, 16) reduction(+ : friction)
+		for (int q = 0; q < count; ++q) {
+			if (!pairFound_[q]) continue;
+			const auto [a, b] = pairs_[begin + q];
+			friction += storePair(step, a, b, pairResults_[q], pairArea_[q], firstContact + pairFirst_[q]);
+		}
 	}
-	releasePlanes(begin, next, chunk);
-	// The chunk's results into the store in pair order, as they would be
-	// without chunks: the pair loop reads only the previous step's
-	// entrances from the store, which these calls leave alone.
-	const int firstContact = static_cast<int>(step.store.contacts().size());
+	stats.frictionContacts += friction;
+}
+
+int ContactDetection::takeChunk(Step& step, int begin, int count) {
+	StepStatistics& stats = step.stats;
+	int contacts = 0;
 	for (int q = 0; q < count; ++q) {
 		stats.subUnitTests += pairWork_[q].subUnitTests;
 		stats.fullSearchPairs += pairWork_[q].fullSearches;
 		if (!pairFound_[q]) continue;
 		const auto [a, b] = pairs_[begin + q];
-		storePair(step, a, b, pairResults_[q], pairArea_[q]);
+		++stats.contactPairs;
+		step.store.setEntrance(a, b, pairResults_[q].entrance);
+		pairFirst_[q] = contacts;
+		contacts += static_cast<int>(pairResults_[q].contacts.size());
 	}
-	prepareContacts(step, firstContact);
+	return step.store.extend(contacts);
 }
 
 // The pair's contact area [m^2] shared by its sub-contacts (bond strengths):
@@ -265,39 +284,32 @@ double ContactDetection::contactArea(const PairContacts& pair) {
 	return projectedHullArea(points, pair.normal) / pair.contacts.size();
 }
 
-// The contacts the chunk added (from `first` on) get their springs, limits
-// and linearised gaps, each from its own blocks alone: in parallel, with the
-// same arithmetic per contact as in any order.
-void ContactDetection::prepareContacts(Step& step, int first) {
+// Each sub-contact takes over its predecessor's history (ContactStore::fill:
+// only this pair's previous contacts are candidates, so pairs run on any
+// thread) and gets its springs, limits and linearised gap from its own
+// blocks alone: the same arithmetic per contact as in any order.
+long ContactDetection::storePair(Step& step, int a, int b, const PairContacts& pair, double area, int first) {
 	std::vector<Contact>& contacts = step.store.contacts();
-	const int last = static_cast<int>(contacts.size());
 	long friction = 0;
-#pragma omp parallel for schedule(dynamic, 64) reduction(+ : friction) if (step.threads && last - first >= 256)
-	for (int k = first; k < last; ++k) {
-		Contact& contact = contacts[k];
+	for (std::size_t k = 0; k < pair.contacts.size(); ++k) {
+		const SubContact& sub = pair.contacts[k];
+		const int i = sub.firstIsA ? a : b, j = sub.firstIsA ? b : a;
+		const ContactKey key{i, j, sub.kind, sub.feature1, sub.feature2};
+		Contact& contact = contacts[first + k];
+		step.store.fill(contact, key, pair.type, sub, *step.blocks[j].shape);
+		contact.area = area;
+		contact.bodyI = bodyIndex(step.blocks, i);
+		contact.bodyJ = bodyIndex(step.blocks, j);
 		prepareContact(contact, step.blocks[contact.bodyI], step.blocks[contact.bodyJ], step.settings);
 		contact.frictionTangent *= step.frictionScale;
 		friction += contact.frictionTangent > 0;
 	}
-	step.stats.frictionContacts += friction;
-}
-
-void ContactDetection::storePair(Step& step, int a, int b, const PairContacts& pair, double area) {
-	++step.stats.contactPairs;
-	step.store.setEntrance(a, b, pair.entrance);
-	for (const SubContact& sub : pair.contacts) {
-		const int i = sub.firstIsA ? a : b, j = sub.firstIsA ? b : a;
-		const ContactKey key{i, j, sub.kind, sub.feature1, sub.feature2};
-		Contact& contact = step.store.add(key, pair.type, sub, *step.blocks[i].shape, *step.blocks[j].shape);
-		contact.area = area;
-		contact.bodyI = bodyIndex(step.blocks, i);
-		contact.bodyJ = bodyIndex(step.blocks, j);
-	}
+	return friction;
 }
 
 std::size_t ContactDetection::memoryBytes() const {
 	std::size_t bytes = capacityBytes(pairs_) + capacityBytes(pairResults_) + capacityBytes(pairFound_) +
-	                    capacityBytes(pairWork_) + capacityBytes(pairArea_) + capacityBytes(planes_) +
+	                    capacityBytes(pairWork_) + capacityBytes(pairArea_) + capacityBytes(pairFirst_) + capacityBytes(planes_) +
 	                    capacityBytes(planeSlot_) + capacityBytes(lastChunk_) + capacityBytes(freePlanes_) +
 	                    capacityBytes(planeBlocks_) + capacityBytes(diagonals_);
 	// Every pooled result and planes entry, found or not: each keeps its capacity.

@@ -76,13 +76,15 @@ private:
 	void claimPlanes(int begin, int next);
 	// The entries of the blocks of pairs [begin, next) whose last chunk is `chunk`.
 	void releasePlanes(int begin, int next, int chunk);
-	// Adds the sub-contacts of pair (a, b) to the store.
-	// A found pair's sub-contacts into the store (in pair order: each takes
-	// over its predecessor's history), with the pair's contact area [m^2].
-	void storePair(Step& step, int a, int b, const PairContacts& pair, double area);
+	// After a chunk's pair loop, in pair order: its counts, the found pairs'
+	// entrances, where each one's contacts go (pairFirst_, from the index
+	// returned: the store's contacts, extended by the chunk's).
+	int takeChunk(Step& step, int begin, int count);
+	// A found pair's sub-contacts, into the store's contacts from `first` on
+	// (each takes over its predecessor's history), with the pair's contact
+	// area [m^2], prepared for the solver; returns how many have friction.
+	long storePair(Step& step, int a, int b, const PairContacts& pair, double area, int first);
 	static double contactArea(const PairContacts& pair);
-	// The springs and linearised gaps of the store's contacts from `first` on.
-	void prepareContacts(Step& step, int first);
 
 	std::vector<std::pair<int, int>> pairs_;
 	// The narrow phase runs the candidate pairs in chunks (kPairChunk in
@@ -110,6 +112,7 @@ private:
 	std::vector<std::vector<char>> internalFaces_;
 	int internalFacesBlocks_ = -1;  // block count when internalFaces_ was computed
 	std::vector<double> pairArea_;  // per pair of the chunk, its contact area [m^2] (found pairs)
+	std::vector<int> pairFirst_;    // per found pair of the chunk, where its contacts start among the chunk's
 };
 
 }  // namespace dda
