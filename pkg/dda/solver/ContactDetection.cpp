@@ -79,8 +79,21 @@ void ContactDetection::detect(const std::vector<Block>& blocks, Collider& collid
 	findPairs(blocks, collider, settings.reuseCandidatePairs, stats);
 	const auto phase = Clock::now();
 	const double cpu = processCpuSeconds();
-	store.beginStep();  // the contact store's work, timed with the narrow phase
-	if (internalFacesBlocks_ != static_cast<int>(blocks.size())) updateInternalFaces(blocks);
+	const int blockCount = static_cast<int>(blocks.size());
+	// The store's turn-over (the contact store's work, timed with the narrow
+	// phase) and the blocks' diagonals are independent serial passes: one
+	// thread each.
+#pragma omp parallel sections if (blockCount >= kMinBlocksForThreads)
+	{
+#pragma omp section
+		store.beginStep();
+#pragma omp section
+		{
+			diagonals_.resize(blocks.size());
+			for (int b = 0; b < blockCount; ++b) diagonals_[b] = boundingDiagonal(blocks[b]);
+		}
+	}
+	if (internalFacesBlocks_ != blockCount) updateInternalFaces(blocks);
 	const int pairCount = static_cast<int>(pairs_.size());
 	// Threads by the step's pair count, not the chunk's: a small scene stays
 	// serial, and a large one's chunks (all but perhaps its last) are large.
@@ -140,9 +153,6 @@ void ContactDetection::updateInternalFaces(const std::vector<Block>& blocks) {
 
 void ContactDetection::startChunks(const std::vector<Block>& blocks) {
 	const int pairCount = static_cast<int>(pairs_.size());
-	std::vector<double>& diagonal = diagonals_;
-	diagonal.resize(blocks.size());
-	for (std::size_t b = 0; b < blocks.size(); ++b) diagonal[b] = boundingDiagonal(blocks[b]);
 	// Each block's planes are built once, before the first chunk with a pair
 	// of it, and kept until its last such chunk (lastChunk_; only the entries
 	// of blocks in a pair are read). Built again in each chunk instead, they

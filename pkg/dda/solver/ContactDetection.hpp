@@ -66,8 +66,8 @@ private:
 	};
 	void findPairs(const std::vector<Block>& blocks, Collider& collider, bool reusePairs, StepStatistics& stats);
 	void updateInternalFaces(const std::vector<Block>& blocks);
-	// Before the first chunk: the per-block diagonals, each block's last
-	// chunk, the planes' free list and the chunk's pooled results.
+	// Before the first chunk (and after the per-block diagonals): each
+	// block's last chunk, the planes' free list and the chunk's pooled results.
 	void startChunks(const std::vector<Block>& blocks);
 	// The narrow phase of pairs_[begin, begin + count) (chunk number `chunk`),
 	// its contacts into the store in pair order.
