@@ -2,6 +2,8 @@
 // terms are EnergyAccount's in IntegratorSettings.hpp).
 #include "World.hpp"
 
+#include "StepClock.hpp"
+
 namespace dda {
 
 EnergyAccount World::energy() const {
@@ -62,12 +64,20 @@ void World::accountStep(const IntegratorSettings& settings) {
 		}
 	}
 	// Contacts: their springs' energy at the start of this step in the
-	// accepted states against what the last step ended with.
-	double start = 0, end = 0;
-	for (const Contact& contact : store_.contacts()) {
+	// accepted states against what the last step ended with. Each contact's
+	// terms are computed on any thread, then summed in contact order.
+	const std::vector<Contact>& contacts = store_.contacts();
+	const int contactCount = static_cast<int>(contacts.size());
+	contactEnergies_.resize(contacts.size());
+#pragma omp parallel for schedule(static) if (contactCount >= kMinContactsForThreads)
+	for (int c = 0; c < contactCount; ++c) {
+		const Contact& contact = contacts[c];
 		const int bi = contact.bodyI, bj = contact.bodyJ;
-		const ContactStepEnergy e = contactStepEnergy(contact, blocks_[bi], blocks_[bj], openClose_.solutionOf(bi),
-		                                              openClose_.solutionOf(bj));
+		contactEnergies_[c] = contactStepEnergy(contact, blocks_[bi], blocks_[bj], openClose_.solutionOf(bi),
+		                                        openClose_.solutionOf(bj));
+	}
+	double start = 0, end = 0;
+	for (const ContactStepEnergy& e : contactEnergies_) {
 		start += e.start;
 		end += e.end;
 		energy_.damping += e.damping;

@@ -162,6 +162,7 @@ private:
 	OpenCloseIteration openClose_;  // the step's moving blocks, system and iteration
 	TimeStepControl timeStep_;
 	std::vector<BlockMotion> motions_;  // moveContactsAndBlocks' work array
+	std::vector<ContactStepEnergy> contactEnergies_;  // accountStep's work array, per contact
 	std::vector<Block> blocks_;
 	TopologyPool topologies_;  // the blocks' shared topologies
 	StepStatistics stats_;

@@ -1,6 +1,6 @@
 // World::step on 1 and 2 threads gives bitwise the same world: every block,
-// every contact in store order with its history, the entrances and the
-// step's counters. The scene is large enough for every threaded loop of the
+// every contact in store order with its history, the entrances, the energy
+// account and the step's counters. The scene is large enough for every threaded loop of the
 // step to run threaded (kMinBlocksForThreads blocks, pairs and MSC's frame
 // tests; kMinContactsForThreads contacts), so a loop whose result depended on
 // how its items were split, or on the order threads finish, shows here.
@@ -98,6 +98,10 @@ TEST_P(ThreadCount, TwoThreadsStepBitwiseAsOne) {
 		ASSERT_GE(s.contacts, kMinContactsForThreads) << "the per-contact loops would run on one thread";
 		expectSameCounters(s, two.lastStep(), step);
 		ASSERT_TRUE(physicsOf(one) == physicsOf(two)) << GetParam() << ": 2 threads differ from 1 at step " << step;
+		const EnergyAccount energyOne = one.energy(), energyTwo = two.energy();
+		for (auto term : {&EnergyAccount::contact, &EnergyAccount::friction, &EnergyAccount::damping,
+		                  &EnergyAccount::contactChanges, &EnergyAccount::kinetic})
+			EXPECT_EQ(energyOne.*term, energyTwo.*term) << "step " << step;
 		bondedContacts += s.bondedContacts;
 	}
 	EXPECT_GT(bondedContacts, 0);
