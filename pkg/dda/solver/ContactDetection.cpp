@@ -10,6 +10,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <cmath>
 
 namespace dda {
 
@@ -24,6 +25,10 @@ namespace {
 // with chunks of 2,048, 1.5 times with 4,096, and with 8,192 no longer than
 // without chunks.
 constexpr int kPairChunk = 8192;
+// A chunk's contacts are made ahead for this x the last chunk's contacts per
+// pair [-] (ContactDetection::detectChunk): a few too many cost their
+// making, too few a serial pass for the rest.
+constexpr double kContactEstimateMargin = 1.1;
 // A pair keeps its entrance feature only while that feature ties with the
 // best axis (within the length tolerance; chooseFace prefers the previous
 // face among ties, so the normal does not flip between equal faces from step
@@ -214,12 +219,20 @@ void ContactDetection::detectChunk(Step& step, int begin, int count, int chunk) 
 	const int planeCount = static_cast<int>(planeBlocks_.size());
 	int firstContact = 0;
 	long friction = 0;
+	// The store's contacts are made (default ones, about 800 bytes each: a
+	// memory-bound serial pass) for an estimate of the chunk's contacts from
+	// the last chunk's contacts per pair, by one thread while the others
+	// build planes, and trimmed or grown to the count found when the pairs
+	// are done (the pair loop reads nothing of the store's contacts).
+	const int estimate = static_cast<int>(std::ceil(kContactEstimateMargin * contactsPerPair_ * count));
 	// One team for the chunk: the planes (the barrier after them completes
 	// them before any pair reads them), the pairs, the store's intake (one
 	// thread: it sets where each pair's contacts go, in pair order, as they
 	// would go without chunks) and the contacts' filling and preparation.
 #pragma omp parallel if (step.threads)
 	{
+#pragma omp single nowait
+		firstContact = step.store.extend(estimate);
 #pragma omp for schedule(dynamic, 32)
 		for (int k = 0; k < planeCount; ++k) {
 			const Block& block = blocks[planeBlocks_[k]];
@@ -255,7 +268,7 @@ void ContactDetection::detectChunk(Step& step, int begin, int count, int chunk) 
 #pragma omp single
 		{
 			releasePlanes(begin, next, chunk);
-			firstContact = takeChunk(step, begin, count);
+			takeChunk(step, begin, count, firstContact);
 		}
 #pragma omp for schedule(dynamic, 16) reduction(+ : friction)
 		for (int q = 0; q < count; ++q) {
@@ -267,7 +280,7 @@ void ContactDetection::detectChunk(Step& step, int begin, int count, int chunk) 
 	stats.frictionContacts += friction;
 }
 
-int ContactDetection::takeChunk(Step& step, int begin, int count) {
+void ContactDetection::takeChunk(Step& step, int begin, int count, int firstContact) {
 	StepStatistics& stats = step.stats;
 	int contacts = 0;
 	for (int q = 0; q < count; ++q) {
@@ -280,7 +293,11 @@ int ContactDetection::takeChunk(Step& step, int begin, int count) {
 		pairFirst_[q] = contacts;
 		contacts += static_cast<int>(pairResults_[q].contacts.size());
 	}
-	return step.store.extend(contacts);
+	std::vector<Contact>& all = step.store.contacts();
+	const int made = static_cast<int>(all.size()) - firstContact;
+	if (contacts < made) all.resize(static_cast<std::size_t>(firstContact + contacts));
+	else step.store.extend(contacts - made);
+	if (count > 0) contactsPerPair_ = static_cast<double>(contacts) / count;
 }
 
 // The pair's contact area [m^2] shared by its sub-contacts (bond strengths):

@@ -77,9 +77,10 @@ private:
 	// The entries of the blocks of pairs [begin, next) whose last chunk is `chunk`.
 	void releasePlanes(int begin, int next, int chunk);
 	// After a chunk's pair loop, in pair order: its counts, the found pairs'
-	// entrances, where each one's contacts go (pairFirst_, from the index
-	// returned: the store's contacts, extended by the chunk's).
-	int takeChunk(Step& step, int begin, int count);
+	// entrances, where each one's contacts go (pairFirst_, from the store's
+	// contact firstContact on: the chunk's first), the store's contacts
+	// trimmed or grown to the chunk's end, and contactsPerPair_.
+	void takeChunk(Step& step, int begin, int count, int firstContact);
 	// A found pair's sub-contacts, into the store's contacts from `first` on
 	// (each takes over its predecessor's history), with the pair's contact
 	// area [m^2], prepared for the solver; returns how many have friction.
@@ -112,6 +113,7 @@ private:
 	std::vector<std::vector<char>> internalFaces_;
 	int internalFacesBlocks_ = -1;  // block count when internalFaces_ was computed
 	std::vector<double> pairArea_;  // per pair of the chunk, its contact area [m^2] (found pairs)
+	double contactsPerPair_ = 1;    // the last chunk's contacts per candidate pair (its estimate for the next)
 	std::vector<int> pairFirst_;    // per found pair of the chunk, where its contacts start among the chunk's
 };
 
