@@ -135,7 +135,7 @@ void MSCCollider::orderedSelect(std::size_t count, std::vector<T>& out, const Ke
 	const long segmentCount = static_cast<long>(segments);
 #pragma omp parallel if (count >= kMinItemsForThreads)
 	{
-#pragma omp for schedule(dynamic, 4)
+#pragma omp for schedule(dynamic, 1)
 		for (long g = 0; g < segmentCount; ++g) {
 			const std::size_t first = static_cast<std::size_t>(g) * kSelectSegment;
 			const std::size_t end = std::min(count, first + kSelectSegment);
@@ -151,7 +151,7 @@ void MSCCollider::orderedSelect(std::size_t count, std::vector<T>& out, const Ke
 			for (std::size_t g = 0; g < segments; ++g) segmentStart_[g + 1] += segmentStart_[g];
 			resizeWithHeadroom(out, segmentStart_[segments]);
 		}
-#pragma omp for schedule(dynamic, 4)
+#pragma omp for schedule(dynamic, 1)
 		for (long g = 0; g < segmentCount; ++g) {
 			const std::size_t first = static_cast<std::size_t>(g) * kSelectSegment;
 			const std::size_t end = std::min(count, first + kSelectSegment);
