@@ -39,22 +39,35 @@ void World::accountStep(const IntegratorSettings& settings) {
 	// force's work is minus the change of the strain energy minus (2 gamma
 	// - 1) times its Bregman divergence (the damping; 0 for average
 	// acceleration), a fixed point's F(0) (1 - gamma) + F(D) gamma.
+	// Each block's damping terms are computed on any thread, then added in
+	// block order (the loads' terms, few, in the same pass).
 	const double gamma = settings.newmarkGamma;
 	const std::vector<int>& moving = openClose_.moving();
 	const int n = static_cast<int>(moving.size());
+	blockEnergies_.resize(moving.size());
+#pragma omp parallel for schedule(static) if (n >= kMinBlocksForThreads)
 	for (int k = 0; k < n; ++k) {
 		const Block& block = blocks_[moving[k]];
 		const Vector12& D = openClose_.solution(k);
-		if (settings.velocityRatio < 1) {
-			// Velocities scaled by velocityRatio at the step's start: the
-			// kinetic energy removed is damping.
-			const double ratio = settings.velocityRatio;
-			energy_.damping += (1 - ratio * ratio) * kineticEnergy(block, block.velocity);
-		}
-		if (!block.rigid) {
+		BlockStepEnergy& e = blockEnergies_[k];
+		// Velocities scaled by velocityRatio at the step's start: the
+		// kinetic energy removed is damping.
+		const double ratio = settings.velocityRatio;
+		e.scaling = ratio < 1 ? (1 - ratio * ratio) * kineticEnergy(block, block.velocity) : 0;
+		e.strained = !block.rigid;
+		if (e.strained) {
 			const Vector6 strain = D.segment<6>(6);
-			energy_.damping += (2 * gamma - 1) * 0.5 * block.referenceVolume() * strain.dot(block.elasticity() * strain);
+			e.strain = (2 * gamma - 1) * 0.5 * block.referenceVolume() * strain.dot(block.elasticity() * strain);
 		}
+		e.loaded = !block.loads.empty() || !block.fixedPoints.empty();
+	}
+	for (int k = 0; k < n; ++k) {
+		const BlockStepEnergy& e = blockEnergies_[k];
+		if (settings.velocityRatio < 1) energy_.damping += e.scaling;
+		if (e.strained) energy_.damping += e.strain;
+		if (!e.loaded) continue;
+		const Block& block = blocks_[moving[k]];
+		const Vector12& D = openClose_.solution(k);
 		for (const PointLoad& load : block.loads)
 			energy_.loads += load.force.dot(displacementAt(load.position - block.centroid, D));
 		for (const FixedPoint& point : block.fixedPoints) {
