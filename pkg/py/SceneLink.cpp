@@ -177,14 +177,13 @@ Eigen::Quaterniond SceneLink::bodyOrientation(int blockIndex) const {
 	return (world.block(blockIndex).rotation * base).normalized();
 }
 
-std::vector<Vector3> SceneLink::localVertices(int blockIndex, const Vector3& position) const {
+void SceneLink::localVertices(int blockIndex, const Vector3& position, std::vector<Vector3>& local) const {
 	const Block& b = world.block(blockIndex);
 	const BodyLink* link = bodyLink(blockIndex);
 	const Eigen::Quaterniond inverse = bodyOrientation(blockIndex).conjugate();
-	std::vector<Vector3> local;
-	if (!link) return local;
+	local.clear();
+	if (!link) return;
 	for (int j : link->vertexOrder) local.push_back(inverse * (b.vertices[j] - position));
-	return local;
 }
 
 }  // namespace dda

@@ -75,8 +75,9 @@ public:
 	Vector3 partPosition(int block) const;
 	// Velocity [m/s] of the block's point at `position` (its partPosition) in its body's motion.
 	Vector3 partVelocity(int block, const Vector3& position) const;
-	// The block's corners in its YADE body's frame, the body at `position` (its partPosition) [m].
-	std::vector<Vector3> localVertices(int block, const Vector3& position) const;
+	// The block's corners in its YADE body's frame, the body at `position`
+	// (its partPosition) [m], into `local` (replaced; none for an unlinked block).
+	void localVertices(int block, const Vector3& position, std::vector<Vector3>& local) const;
 
 	// World::reserveBlocks, and as much room in the body links.
 	void reserveBlocks(int extra);

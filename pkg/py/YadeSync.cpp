@@ -1,6 +1,10 @@
 // The C++ sync into YADE's containers (YadeSync.hpp says what is kept and why).
 #include "YadeSync.hpp"
 
+#include "dda/solver/StepClock.hpp"
+
+#include <omp.h>
+
 #include <algorithm>
 #include <string>
 
@@ -89,33 +93,54 @@ const YadeSync::VertexList& YadeSync::vertexList(std::size_t count) {
 	return found->second;
 }
 
-int YadeSync::writeBodies(SceneLink& s, const py::object& bodies, bool all) {
-	const Names& n = names();
-	int written = 0;
-	for (int i = 0; i < s.world.blockCount(); ++i) {
-		Block& b = s.world.block(i);
-		BodyLink* link = s.bodyLink(i);
+// Everything a body's write needs, per block: pure C++ on the blocks and
+// links (nothing of Python), each block its own entry, so on any thread.
+void YadeSync::prepareBodies(const SceneLink& s, bool all, int threads) {
+	const int n = s.world.blockCount();
+	if (static_cast<int>(bodyValues_.size()) < n) bodyValues_.resize(n);
+#pragma omp parallel for schedule(static, 64) num_threads(threads > 0 ? threads : omp_get_max_threads()) \
+    if (n >= kMinBlocksForThreads)
+	for (int i = 0; i < n; ++i) {
+		BodyValues& values = bodyValues_[i];
+		const Block& b = s.world.block(i);
+		const BodyLink* link = s.bodyLink(i);
 		const bool first = !link || !link->synced || resend_;  // a first write (or to objects new to this writer)
-		if (!link || (b.fixed && !first && !all)) continue;
-		BodyObjects& body = bodyObjects(bodies, i, link->bodyId);
-		PyObject* state = body.state.ptr();
+		values.write = link && !(b.fixed && !first && !all);
+		if (!values.write) continue;
 		// A part of a concave block: its own centroid, moving with its body.
 		const Block& moving = b.isPart() ? s.world.block(s.world.bodyOf(i)) : b;
-		const Vector3 position = b.isPart() ? s.partPosition(i) : b.centroid;
-		setVector(state, n.pos, position);
-		*quaternionValue_ = s.bodyOrientation(i);
-		check(PyObject_SetAttr(state, n.ori, quaternion_.ptr()));
-		setVector(state, n.vel, b.isPart() ? s.partVelocity(i, position) : b.velocity.head<3>());
-		setVector(state, n.angVel, moving.velocity.segment<3>(3));
+		values.position = b.isPart() ? s.partPosition(i) : b.centroid;
+		values.orientation = s.bodyOrientation(i);
+		values.velocity = b.isPart() ? s.partVelocity(i, values.position) : b.velocity.head<3>();
+		values.angularVelocity = moving.velocity.segment<3>(3);
 		// Vertices in the body's local frame and vertex order: at the first
 		// write (YADE's frame is at YADE's centroid, the core's at its own:
 		// they differ by round-off), then when strained since the last one.
-		if (all || first || b.unsyncedStrain > SceneLink::kVertexSyncStrain) {
-			const std::vector<Vector3> local = s.localVertices(i, position);
-			const VertexList& list = vertexList(local.size());
-			for (std::size_t k = 0; k < local.size(); ++k) *list.values[k] = local[k];
+		values.vertices = all || first || b.unsyncedStrain > SceneLink::kVertexSyncStrain;
+		if (values.vertices) s.localVertices(i, values.position, values.local);
+	}
+}
+
+int YadeSync::writeBodies(SceneLink& s, const py::object& bodies, bool all, int threads) {
+	const Names& n = names();
+	prepareBodies(s, all, threads);
+	int written = 0;
+	for (int i = 0; i < s.world.blockCount(); ++i) {
+		const BodyValues& values = bodyValues_[i];
+		if (!values.write) continue;
+		BodyLink* link = s.bodyLink(i);
+		BodyObjects& body = bodyObjects(bodies, i, link->bodyId);
+		PyObject* state = body.state.ptr();
+		setVector(state, n.pos, values.position);
+		*quaternionValue_ = values.orientation;
+		check(PyObject_SetAttr(state, n.ori, quaternion_.ptr()));
+		setVector(state, n.vel, values.velocity);
+		setVector(state, n.angVel, values.angularVelocity);
+		if (values.vertices) {
+			const VertexList& list = vertexList(values.local.size());
+			for (std::size_t k = 0; k < values.local.size(); ++k) *list.values[k] = values.local[k];
 			check(PyObject_SetAttr(body.shape.ptr(), n.v, list.list.ptr()));
-			b.unsyncedStrain = 0;
+			s.world.block(i).unsyncedStrain = 0;
 		}
 		link->synced = true;
 		++written;

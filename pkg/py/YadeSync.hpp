@@ -69,8 +69,11 @@ public:
 
 	// Moving blocks' (every block's if all) position, orientation, velocity,
 	// angular velocity, and vertices when strained since the last write;
-	// returns how many bodies were written.
-	int writeBodies(SceneLink& s, const py::object& bodies, bool all);
+	// returns how many bodies were written. The values are computed first,
+	// on `threads` threads (0: OpenMP's count) from kMinBlocksForThreads
+	// blocks on, then written from the calling thread (YADE's setters hold
+	// Python's lock).
+	int writeBodies(SceneLink& s, const py::object& bodies, bool all, int threads = 0);
 	// O.forces (forces) holds each block's force and torque, and
 	// O.interactions (interactions) the pairs' views when keep (else none of
 	// them); foreign: DDA pairs already in O.interactions that this object
@@ -99,6 +102,14 @@ private:
 	static BodyObjects lookUp(const py::object& bodies, int bodyId);
 	int writeClumps(SceneLink& s, const py::object& bodies, bool all);
 	PairObjects pairObjects(const py::object& interactions, int id1, int id2);
+	// What writeBodies writes into one body, computed before any write.
+	struct BodyValues {
+		bool write = false, vertices = false;  // whether the body is written, with its vertices
+		Vector3 position, velocity, angularVelocity;
+		Eigen::Quaterniond orientation;
+		std::vector<Vector3> local;  // its vertices in its frame (when `vertices`; kept for its capacity)
+	};
+	void prepareBodies(const SceneLink& s, bool all, int threads);
 	struct VertexList {
 		py::object list;               // of `count` Vector3 objects...
 		std::vector<Vector3*> values;  // ... and their values, refilled before each write
@@ -115,6 +126,7 @@ private:
 	Vector3* vectorValue_;
 	Eigen::Quaterniond* quaternionValue_;
 	std::vector<BodyObjects> bodies_;                  // per block
+	std::vector<BodyValues> bodyValues_;               // per block, prepareBodies' results
 	std::map<int, BodyObjects> clumpObjects_;          // per concave block's body: its clump's
 	bool resend_ = false;                              // write every body in full next (forgetBodies)
 	std::map<std::size_t, VertexList> vertexLists_;    // per vertex count

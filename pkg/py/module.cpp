@@ -579,9 +579,11 @@ BOOST_PYTHON_MODULE(_core) {
 	    "O.forces, O.interactions. One per DDA scene; it keeps YADE's objects it wrote to.",
 	    py::init<py::object, py::object, py::object>(
 	        (py::arg("geomClass"), py::arg("physClass"), py::arg("createInteraction"))))
-	    .def("writeBodies", &YadeSync::writeBodies, (py::arg("scene"), py::arg("bodies"), py::arg("all")),
+	    .def("writeBodies", &YadeSync::writeBodies,
+	         (py::arg("scene"), py::arg("bodies"), py::arg("all"), py::arg("threads") = 0),
 	         "Writes moving blocks' (every block's if all) pos, ori, vel, angVel and, when strained, vertices into "
-	         "their bodies (bodies: O.bodies); returns how many.")
+	         "their bodies (bodies: O.bodies); returns how many. The values are computed on `threads` threads "
+	         "(0: OpenMP's count) from 1024 blocks on, and written from the calling thread.")
 	    .def("writeViews", &YadeSync::writeViews,
 	         (py::arg("scene"), py::arg("settings"), py::arg("forces"), py::arg("interactions"), py::arg("keep"),
 	          py::arg("foreign")),

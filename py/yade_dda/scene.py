@@ -125,7 +125,9 @@ class DDAScene:
         Python's garbage collector (the Python loop this replaced made a tuple of vectors per block,
         and the collector's passes took two thirds of its time at 10,000 blocks)."""
         start = time.perf_counter()
-        self.syncedBodies = self.writer().writeBodies(self.core, O.bodies, everything)
+        settings = getattr(self, 'settings', None)
+        self.syncedBodies = self.writer().writeBodies(self.core, O.bodies, everything,
+                                                      settings.threads if settings is not None else 0)
         middle = time.perf_counter()
         _views.update(self)
         end = time.perf_counter()

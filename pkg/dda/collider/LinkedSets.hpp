@@ -26,6 +26,13 @@ public:
 	// vertices, then edges, then faces, whose counts are `counts`.
 	int find(int& chain, int& setCount, const ShellRange* linkedShells, const std::array<int, 3>& counts,
 	         std::uint64_t shells);
+	// The block's set for `shells` if it has one, else -1; changes nothing
+	// (the chain's order neither), so calls may run at once.
+	int lookup(int chain, std::uint64_t shells) const {
+		for (int k = chain; k >= 0; k = sets_[k].next)
+			if (sets_[k].shells == shells) return k;
+		return -1;
+	}
 	// The set's lists of vertices, edges and faces (sorted, unique).
 	const std::vector<int>& vertices(int set) const { return lists_[sets_[set].lists[0]]; }
 	const std::vector<int>& edges(int set) const { return lists_[sets_[set].lists[1]]; }

@@ -38,6 +38,11 @@ constexpr std::size_t kPrefetchHits = 16;
 // about 0.2 us).
 constexpr int kPrefetchGroups = 8;
 constexpr int kMinGroupsForThreads = 1024;
+// The ordered selections (orderedSelect): segments of this many items, and
+// the fewest items worth a thread team (an item's test is a few nanoseconds,
+// waking a team tens of microseconds).
+constexpr std::size_t kSelectSegment = 4096;
+constexpr std::size_t kMinItemsForThreads = 16384;
 
 }  // namespace
 
@@ -116,6 +121,47 @@ void MSCCollider::sortShellPairs(std::vector<ItemPair>& pairs, int blocks, std::
 	}
 }
 
+// The items k in [0, count) for which keep(k) holds, in ascending order, as
+// out[i] = make(k) (out resized to their number). Each segment of
+// kSelectSegment items is tested on any thread and counted; the segments'
+// offsets are then summed in order and each segment writes its own items from
+// its offset: the serial loop's result, however the segments were shared.
+template <class T, class Keep, class Make>
+void MSCCollider::orderedSelect(std::size_t count, std::vector<T>& out, const Keep& keep, const Make& make) {
+	const std::size_t segments = (count + kSelectSegment - 1) / kSelectSegment;
+	resizeWithHeadroom(selectKept_, count);
+	resizeWithHeadroom(segmentStart_, segments + 1);
+	segmentStart_[0] = 0;
+	const long segmentCount = static_cast<long>(segments);
+#pragma omp parallel if (count >= kMinItemsForThreads)
+	{
+#pragma omp for schedule(dynamic, 1)
+		for (long g = 0; g < segmentCount; ++g) {
+			const std::size_t first = static_cast<std::size_t>(g) * kSelectSegment;
+			const std::size_t end = std::min(count, first + kSelectSegment);
+			std::size_t kept = 0;
+			for (std::size_t k = first; k < end; ++k) {
+				selectKept_[k] = keep(k);
+				kept += selectKept_[k];
+			}
+			segmentStart_[g + 1] = kept;
+		}
+#pragma omp single
+		{
+			for (std::size_t g = 0; g < segments; ++g) segmentStart_[g + 1] += segmentStart_[g];
+			resizeWithHeadroom(out, segmentStart_[segments]);
+		}
+#pragma omp for schedule(dynamic, 1)
+		for (long g = 0; g < segmentCount; ++g) {
+			const std::size_t first = static_cast<std::size_t>(g) * kSelectSegment;
+			const std::size_t end = std::min(count, first + kSelectSegment);
+			std::size_t at = segmentStart_[g];
+			for (std::size_t k = first; k < end; ++k)
+				if (selectKept_[k]) out[at++] = make(k);
+		}
+	}
+}
+
 void MSCCollider::findPairs(const std::vector<Block>& blocks, double contactDistance,
                             std::vector<std::pair<int, int>>& pairs, BroadPhaseStatistics& stats) {
 	pairs.clear();
@@ -141,6 +187,7 @@ void MSCCollider::findShellHits(const std::vector<Block>& blocks, double margin,
 	const int shellTotal = cover_.shellTotal();
 	const std::vector<Eigen::AlignedBox3d>& boxes = cover_.boxes();
 	resizeWithHeadroom(widened_, shellTotal);
+#pragma omp parallel for schedule(static) if (static_cast<std::size_t>(shellTotal) >= kMinItemsForThreads)
 	for (int s = 0; s < shellTotal; ++s) {
 		const Vector3 w = Vector3::Constant(margin + cover_.cover(cover_.shellBlock()[s]).widening);
 		widened_[s] = Eigen::AlignedBox3d(boxes[s].min() - w, boxes[s].max() + w);
@@ -158,36 +205,44 @@ void MSCCollider::findShellHits(const std::vector<Block>& blocks, double margin,
 	// meet. (The second shells lie anywhere: the box of the one
 	// kPrefetchHits pairs ahead is fetched meanwhile.)
 	const std::vector<ItemPair>& cached = cache_.pairs();
-	for (std::size_t k = 0; k < cached.size(); ++k) {
-		if (k + kPrefetchHits < cached.size()) {
-			const Eigen::AlignedBox3d* ahead = &widened_[cached[k + kPrefetchHits].second];
-			__builtin_prefetch(ahead);
-			__builtin_prefetch(reinterpret_cast<const char*>(ahead + 1) - 1);
-		}
-		const ItemPair& p = cached[k];
-		if (widened_[p.first].intersects(widened_[p.second])) pushWithHeadroom(hits_, p);
-	}
-	stats.shellTests += static_cast<long>(cached.size());
+	const std::size_t cachedCount = cached.size();
+	orderedSelect(
+	    cachedCount, hits_,
+	    [&](std::size_t k) {
+		    if (k + kPrefetchHits < cachedCount) {
+			    const Eigen::AlignedBox3d* ahead = &widened_[cached[k + kPrefetchHits].second];
+			    __builtin_prefetch(ahead);
+			    __builtin_prefetch(reinterpret_cast<const char*>(ahead + 1) - 1);
+		    }
+		    return widened_[cached[k].first].intersects(widened_[cached[k].second]);
+	    },
+	    [&](std::size_t k) { return cached[k]; });
+	stats.shellTests += static_cast<long>(cachedCount);
 }
 
 // The frame test of each block pair's shell pairs (a run of hits_ with the
-// same two blocks: a group) is pure and runs on the step's threads; the
-// candidates and their linked sets (interned in order: set numbers follow
-// the pairs) are then taken in group order, as by one thread.
+// same two blocks: a group) is pure and runs on the step's threads, which
+// also look up the linked sets the pair's shells already have (a lookup
+// changes nothing). The candidates and the sets still to build are then
+// taken in group order, as by one thread: sets are numbered as they are
+// built, and a set built for one group is found by the later ones.
 void MSCCollider::testBlockPairs(double margin, std::vector<std::pair<int, int>>& pairs, BroadPhaseStatistics& stats) {
 	const std::vector<int>& shellBlock = cover_.shellBlock();
 	const std::vector<msc::Frame>& frames = cover_.frames();
 	candidateSets_.clear();
-	groupStart_.clear();
-	for (std::size_t h = 0; h < hits_.size(); ++h) {
-		if (h == 0 || shellBlock[hits_[h].first] != shellBlock[hits_[h - 1].first] ||
-		    shellBlock[hits_[h].second] != shellBlock[hits_[h - 1].second])
-			groupStart_.push_back(h);
-	}
+	const std::size_t hitCount = hits_.size();
+	orderedSelect(
+	    hitCount, groupStart_,
+	    [&](std::size_t h) {
+		    return h == 0 || shellBlock[hits_[h].first] != shellBlock[hits_[h - 1].first] ||
+		           shellBlock[hits_[h].second] != shellBlock[hits_[h - 1].second];
+	    },
+	    [](std::size_t h) { return h; });
 	const int groups = static_cast<int>(groupStart_.size());
-	groupStart_.push_back(hits_.size());
+	groupStart_.push_back(hitCount);
 	groupShells_.resize(groups);
-	stats.shellTests += static_cast<long>(hits_.size());
+	groupSets_.resize(groups);
+	stats.shellTests += static_cast<long>(hitCount);
 	long shellPairs = 0;
 #pragma omp parallel for schedule(dynamic, 256) reduction(+ : shellPairs) if (groups >= kMinGroupsForThreads)
 	for (int g = 0; g < groups; ++g) {
@@ -213,38 +268,42 @@ void MSCCollider::testBlockPairs(double margin, std::vector<std::pair<int, int>>
 			shellsB |= std::uint64_t{1} << (t - fb.firstShell);
 		}
 		groupShells_[g] = {shellsA, shellsB};
+		if (shellsA) groupSets_[g] = {linkedSets_.lookup(fa.linkedSets, shellsA), linkedSets_.lookup(fb.linkedSets, shellsB)};
 	}
 	stats.shellPairs += shellPairs;
 	for (int g = 0; g < groups; ++g) {
-		if (g + kPrefetchGroups < groups) {   // the second block's first linked set (its frame is in cache)
-			const int set = frames[shellBlock[hits_[groupStart_[g + kPrefetchGroups]].second]].linkedSets;
-			if (set >= 0) linkedSets_.prefetch(set);
-		}
 		const auto [shellsA, shellsB] = groupShells_[g];
 		if (!shellsA) continue;
 		const int a = shellBlock[hits_[groupStart_[g]].first], b = shellBlock[hits_[groupStart_[g]].second];
 		pairs.emplace_back(a, b);
-		pushWithHeadroom(candidateSets_, {linkedSet(a, shellsA), linkedSet(b, shellsB)});
+		const auto [setA, setB] = groupSets_[g];
+		pushWithHeadroom(candidateSets_, {setA >= 0 ? setA : linkedSet(a, shellsA), setB >= 0 ? setB : linkedSet(b, shellsB)});
 	}
 }
 
 void MSCCollider::fillLinked(std::size_t candidates, BroadPhaseStatistics& stats) {
 	if (linked_.size() < candidates) resizeWithHeadroom(linked_, candidates);
-	for (const std::array<int, 2>& sets : candidateSets_) {
-		LinkedSubUnits& out = linked_[linkedCount_++];
+	const int count = static_cast<int>(candidateSets_.size());
+	long subUnitPairs = 0;
+#pragma omp parallel for schedule(static) reduction(+ : subUnitPairs) if (count >= kMinGroupsForThreads)
+	for (int k = 0; k < count; ++k) {
+		const std::array<int, 2>& sets = candidateSets_[k];
+		LinkedSubUnits& out = linked_[k];
 		for (int i = 0; i < 2; ++i) {
 			out.vertices[i] = SubUnitList(linkedSets_.vertices(sets[i]));
 			out.edges[i] = SubUnitList(linkedSets_.edges(sets[i]));
 			out.faces[i] = SubUnitList(linkedSets_.faces(sets[i]));
 		}
-		stats.subUnitPairs += out.subUnitPairs();
+		subUnitPairs += out.subUnitPairs();
 	}
+	linkedCount_ = count;
+	stats.subUnitPairs += subUnitPairs;
 }
 
 std::size_t MSCCollider::memoryBytes() const {
 	return cover_.memoryBytes() + grid_.memoryBytes() + linkedSets_.memoryBytes() + cache_.memoryBytes() +
 	       capacityBytes(widened_) + capacityBytes(pairStart_) + capacityBytes(hits_) + capacityBytes(candidateSets_) + capacityBytes(groupStart_) +
-	       capacityBytes(groupShells_) +
+	       capacityBytes(groupShells_) + capacityBytes(groupSets_) + capacityBytes(selectKept_) + capacityBytes(segmentStart_) +
 	       capacityBytes(linked_);
 }
 

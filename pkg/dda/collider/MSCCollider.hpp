@@ -131,6 +131,10 @@ private:
 	void testBlockPairs(double margin, std::vector<std::pair<int, int>>& pairs, BroadPhaseStatistics& stats);
 	// linked_ from the candidates' linked sets.
 	void fillLinked(std::size_t candidates, BroadPhaseStatistics& stats);
+	// The items k < count with keep(k), in order, into out as make(k) (on the
+	// step's threads, the same for any number of them: MSCCollider.cpp).
+	template <class T, class Keep, class Make>
+	void orderedSelect(std::size_t count, std::vector<T>& out, const Keep& keep, const Make& make);
 	// Sorts shell pairs by first block, then (t, s): by block pair
 	// (`scratch`: work space, its contents lost).
 	void sortShellPairs(std::vector<ItemPair>& pairs, int blocks, std::vector<ItemPair>& scratch);
@@ -149,6 +153,9 @@ private:
 	std::vector<std::array<int, 2>> candidateSets_;
 	std::vector<std::size_t> groupStart_;                               // testBlockPairs: runs of hits_ per block pair
 	std::vector<std::pair<std::uint64_t, std::uint64_t>> groupShells_;  // and their near shells (bit masks)
+	std::vector<std::pair<int, int>> groupSets_;  // and those shells' linked sets when they had one, else -1
+	std::vector<char> selectKept_;                // orderedSelect: per item, whether it is kept
+	std::vector<std::size_t> segmentStart_;       // and where each segment's kept items start
 	std::vector<LinkedSubUnits> linked_;  // the first linkedCount_ are valid
 	int linkedCount_ = 0;
 };

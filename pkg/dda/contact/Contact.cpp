@@ -97,12 +97,24 @@ Contact& ContactStore::add(const ContactKey& key, ContactType pairType, const Su
                            const PolyhedronTopology& shapeI, const PolyhedronTopology& shapeJ) {
 	(void)shapeI;
 	Contact& contact = current_.emplace_back();
+	fill(contact, key, pairType, geometry, shapeJ);
+	return contact;
+}
+
+int ContactStore::extend(int count) {
+	const int first = static_cast<int>(current_.size());
+	current_.resize(current_.size() + static_cast<std::size_t>(std::max(count, 0)));
+	return first;
+}
+
+void ContactStore::fill(Contact& contact, const ContactKey& key, ContactType pairType, const SubContact& geometry,
+                        const PolyhedronTopology& shapeJ) {
 	contact.key = key;
 	contact.bodyI = key.blockI;  // ContactDetection::storePair sets the bodies of concave blocks' parts
 	contact.bodyJ = key.blockJ;
 	contact.pairType = pairType;
 	contact.geometry = geometry;
-	if (previous_.empty()) return contact;
+	if (previous_.empty()) return;
 
 	int predecessor = -1;
 	const int exact = previousIndex(key);
@@ -143,7 +155,6 @@ Contact& ContactStore::add(const ContactKey& key, ContactType pairType, const Su
 			h.shearForce = -h.shearForce;
 		}
 	}
-	return contact;
 }
 
 const EntranceFeature& ContactStore::previousEntrance(int a, int b) const {

@@ -115,6 +115,16 @@ public:
 	// give the topology for the neighbour search.
 	Contact& add(const ContactKey& key, ContactType pairType, const SubContact& geometry,
 	             const PolyhedronTopology& shapeI, const PolyhedronTopology& shapeJ);
+	// The same in two parts, for adding many pairs' sub-contacts on several
+	// threads: extend appends `count` default contacts (returns the index of
+	// the first), fill makes one of them the detected sub-contact as add
+	// would. A sub-contact's predecessor is one of its own block pair's
+	// previous contacts, so fill calls for different block pairs touch
+	// different entries and may run at once; those of one pair must run in
+	// the order add would have been called (the first to ask claims).
+	int extend(int count);
+	void fill(Contact& contact, const ContactKey& key, ContactType pairType, const SubContact& geometry,
+	          const PolyhedronTopology& shapeJ);
 	std::vector<Contact>& contacts() { return current_; }
 	const std::vector<Contact>& contacts() const { return current_; }
 

@@ -10,6 +10,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <cmath>
 
 namespace dda {
 
@@ -24,6 +25,10 @@ namespace {
 // with chunks of 2,048, 1.5 times with 4,096, and with 8,192 no longer than
 // without chunks.
 constexpr int kPairChunk = 8192;
+// A chunk's contacts are made ahead for this x the last chunk's contacts per
+// pair [-] (ContactDetection::detectChunk): a few too many cost their
+// making, too few a serial pass for the rest.
+constexpr double kContactEstimateMargin = 1.1;
 // A pair keeps its entrance feature only while that feature ties with the
 // best axis (within the length tolerance; chooseFace prefers the previous
 // face among ties, so the normal does not flip between equal faces from step
@@ -79,8 +84,21 @@ void ContactDetection::detect(const std::vector<Block>& blocks, Collider& collid
 	findPairs(blocks, collider, settings.reuseCandidatePairs, stats);
 	const auto phase = Clock::now();
 	const double cpu = processCpuSeconds();
-	store.beginStep();  // the contact store's work, timed with the narrow phase
-	if (internalFacesBlocks_ != static_cast<int>(blocks.size())) updateInternalFaces(blocks);
+	const int blockCount = static_cast<int>(blocks.size());
+	// The store's turn-over (the contact store's work, timed with the narrow
+	// phase) and the blocks' diagonals are independent serial passes: one
+	// thread each.
+#pragma omp parallel sections if (blockCount >= kMinBlocksForThreads)
+	{
+#pragma omp section
+		store.beginStep();
+#pragma omp section
+		{
+			diagonals_.resize(blocks.size());
+			for (int b = 0; b < blockCount; ++b) diagonals_[b] = boundingDiagonal(blocks[b]);
+		}
+	}
+	if (internalFacesBlocks_ != blockCount) updateInternalFaces(blocks);
 	const int pairCount = static_cast<int>(pairs_.size());
 	// Threads by the step's pair count, not the chunk's: a small scene stays
 	// serial, and a large one's chunks (all but perhaps its last) are large.
@@ -140,9 +158,6 @@ void ContactDetection::updateInternalFaces(const std::vector<Block>& blocks) {
 
 void ContactDetection::startChunks(const std::vector<Block>& blocks) {
 	const int pairCount = static_cast<int>(pairs_.size());
-	std::vector<double>& diagonal = diagonals_;
-	diagonal.resize(blocks.size());
-	for (std::size_t b = 0; b < blocks.size(); ++b) diagonal[b] = boundingDiagonal(blocks[b]);
 	// Each block's planes are built once, before the first chunk with a pair
 	// of it, and kept until its last such chunk (lastChunk_; only the entries
 	// of blocks in a pair are read). Built again in each chunk instead, they
@@ -164,6 +179,7 @@ void ContactDetection::startChunks(const std::vector<Block>& blocks) {
 	pairFound_.resize(chunkCapacity);
 	pairWork_.resize(chunkCapacity);
 	pairArea_.resize(chunkCapacity);
+	pairFirst_.resize(chunkCapacity);
 }
 
 void ContactDetection::claimPlanes(int begin, int next) {
@@ -201,17 +217,28 @@ void ContactDetection::detectChunk(Step& step, int begin, int count, int chunk) 
 	const int next = begin + count;
 	claimPlanes(begin, next);
 	const int planeCount = static_cast<int>(planeBlocks_.size());
-	// One team for both loops: the barrier after the first completes the
-	// planes before any pair reads them, the region's end waits for the
-	// pairs (nowait: no barrier of its own).
+	int firstContact = 0;
+	long friction = 0;
+	// The store's contacts are made (default ones, about 800 bytes each: a
+	// memory-bound serial pass) for an estimate of the chunk's contacts from
+	// the last chunk's contacts per pair, by one thread while the others
+	// build planes, and trimmed or grown to the count found when the pairs
+	// are done (the pair loop reads nothing of the store's contacts).
+	const int estimate = static_cast<int>(std::ceil(kContactEstimateMargin * contactsPerPair_ * count));
+	// One team for the chunk: the planes (the barrier after them completes
+	// them before any pair reads them), the pairs, the store's intake (one
+	// thread: it sets where each pair's contacts go, in pair order, as they
+	// would go without chunks) and the contacts' filling and preparation.
 #pragma omp parallel if (step.threads)
 	{
+#pragma omp single nowait
+		firstContact = step.store.extend(estimate);
 #pragma omp for schedule(dynamic, 32)
 		for (int k = 0; k < planeCount; ++k) {
 			const Block& block = blocks[planeBlocks_[k]];
 			planes_[planeSlot_[planeBlocks_[k]]].compute(*block.shape, block.vertices);
 		}
-#pragma omp for schedule(dynamic, 16) nowait
+#pragma omp for schedule(dynamic, 16)
 		for (int q = 0; q < count; ++q) {
 			const auto [a, b] = pairs_[begin + q];
 			const Block& A = blocks[a];
@@ -238,20 +265,39 @@ void ContactDetection::detectChunk(Step& step, int begin, int count, int chunk) 
 			                    std::min(A.material.tensileStrength, B.material.tensileStrength) > 0;
 			if (pairFound_[q]) pairArea_[q] = bonded ? contactArea(pairResults_[q]) : 0.0;
 		}
+#pragma omp single
+		{
+			releasePlanes(begin, next, chunk);
+			takeChunk(step, begin, count, firstContact);
+		}
+#pragma omp for schedule(dynamic, 16) reduction(+ : friction)
+		for (int q = 0; q < count; ++q) {
+			if (!pairFound_[q]) continue;
+			const auto [a, b] = pairs_[begin + q];
+			friction += storePair(step, a, b, pairResults_[q], pairArea_[q], firstContact + pairFirst_[q]);
+		}
 	}
-	releasePlanes(begin, next, chunk);
-	// The chunk's results into the store in pair order, as they would be
-	// without chunks: the pair loop reads only the previous step's
-	// entrances from the store, which these calls leave alone.
-	const int firstContact = static_cast<int>(step.store.contacts().size());
+	stats.frictionContacts += friction;
+}
+
+void ContactDetection::takeChunk(Step& step, int begin, int count, int firstContact) {
+	StepStatistics& stats = step.stats;
+	int contacts = 0;
 	for (int q = 0; q < count; ++q) {
 		stats.subUnitTests += pairWork_[q].subUnitTests;
 		stats.fullSearchPairs += pairWork_[q].fullSearches;
 		if (!pairFound_[q]) continue;
 		const auto [a, b] = pairs_[begin + q];
-		storePair(step, a, b, pairResults_[q], pairArea_[q]);
+		++stats.contactPairs;
+		step.store.setEntrance(a, b, pairResults_[q].entrance);
+		pairFirst_[q] = contacts;
+		contacts += static_cast<int>(pairResults_[q].contacts.size());
 	}
-	prepareContacts(step, firstContact);
+	std::vector<Contact>& all = step.store.contacts();
+	const int made = static_cast<int>(all.size()) - firstContact;
+	if (contacts < made) all.resize(static_cast<std::size_t>(firstContact + contacts));
+	else step.store.extend(contacts - made);
+	if (count > 0) contactsPerPair_ = static_cast<double>(contacts) / count;
 }
 
 // The pair's contact area [m^2] shared by its sub-contacts (bond strengths):
@@ -265,39 +311,32 @@ double ContactDetection::contactArea(const PairContacts& pair) {
 	return projectedHullArea(points, pair.normal) / pair.contacts.size();
 }
 
-// The contacts the chunk added (from `first` on) get their springs, limits
-// and linearised gaps, each from its own blocks alone: in parallel, with the
-// same arithmetic per contact as in any order.
-void ContactDetection::prepareContacts(Step& step, int first) {
+// Each sub-contact takes over its predecessor's history (ContactStore::fill:
+// only this pair's previous contacts are candidates, so pairs run on any
+// thread) and gets its springs, limits and linearised gap from its own
+// blocks alone: the same arithmetic per contact as in any order.
+long ContactDetection::storePair(Step& step, int a, int b, const PairContacts& pair, double area, int first) {
 	std::vector<Contact>& contacts = step.store.contacts();
-	const int last = static_cast<int>(contacts.size());
 	long friction = 0;
-#pragma omp parallel for schedule(dynamic, 64) reduction(+ : friction) if (step.threads && last - first >= 256)
-	for (int k = first; k < last; ++k) {
-		Contact& contact = contacts[k];
+	for (std::size_t k = 0; k < pair.contacts.size(); ++k) {
+		const SubContact& sub = pair.contacts[k];
+		const int i = sub.firstIsA ? a : b, j = sub.firstIsA ? b : a;
+		const ContactKey key{i, j, sub.kind, sub.feature1, sub.feature2};
+		Contact& contact = contacts[first + k];
+		step.store.fill(contact, key, pair.type, sub, *step.blocks[j].shape);
+		contact.area = area;
+		contact.bodyI = bodyIndex(step.blocks, i);
+		contact.bodyJ = bodyIndex(step.blocks, j);
 		prepareContact(contact, step.blocks[contact.bodyI], step.blocks[contact.bodyJ], step.settings);
 		contact.frictionTangent *= step.frictionScale;
 		friction += contact.frictionTangent > 0;
 	}
-	step.stats.frictionContacts += friction;
-}
-
-void ContactDetection::storePair(Step& step, int a, int b, const PairContacts& pair, double area) {
-	++step.stats.contactPairs;
-	step.store.setEntrance(a, b, pair.entrance);
-	for (const SubContact& sub : pair.contacts) {
-		const int i = sub.firstIsA ? a : b, j = sub.firstIsA ? b : a;
-		const ContactKey key{i, j, sub.kind, sub.feature1, sub.feature2};
-		Contact& contact = step.store.add(key, pair.type, sub, *step.blocks[i].shape, *step.blocks[j].shape);
-		contact.area = area;
-		contact.bodyI = bodyIndex(step.blocks, i);
-		contact.bodyJ = bodyIndex(step.blocks, j);
-	}
+	return friction;
 }
 
 std::size_t ContactDetection::memoryBytes() const {
 	std::size_t bytes = capacityBytes(pairs_) + capacityBytes(pairResults_) + capacityBytes(pairFound_) +
-	                    capacityBytes(pairWork_) + capacityBytes(pairArea_) + capacityBytes(planes_) +
+	                    capacityBytes(pairWork_) + capacityBytes(pairArea_) + capacityBytes(pairFirst_) + capacityBytes(planes_) +
 	                    capacityBytes(planeSlot_) + capacityBytes(lastChunk_) + capacityBytes(freePlanes_) +
 	                    capacityBytes(planeBlocks_) + capacityBytes(diagonals_);
 	// Every pooled result and planes entry, found or not: each keeps its capacity.

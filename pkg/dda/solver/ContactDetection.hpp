@@ -66,8 +66,8 @@ private:
 	};
 	void findPairs(const std::vector<Block>& blocks, Collider& collider, bool reusePairs, StepStatistics& stats);
 	void updateInternalFaces(const std::vector<Block>& blocks);
-	// Before the first chunk: the per-block diagonals, each block's last
-	// chunk, the planes' free list and the chunk's pooled results.
+	// Before the first chunk (and after the per-block diagonals): each
+	// block's last chunk, the planes' free list and the chunk's pooled results.
 	void startChunks(const std::vector<Block>& blocks);
 	// The narrow phase of pairs_[begin, begin + count) (chunk number `chunk`),
 	// its contacts into the store in pair order.
@@ -76,13 +76,16 @@ private:
 	void claimPlanes(int begin, int next);
 	// The entries of the blocks of pairs [begin, next) whose last chunk is `chunk`.
 	void releasePlanes(int begin, int next, int chunk);
-	// Adds the sub-contacts of pair (a, b) to the store.
-	// A found pair's sub-contacts into the store (in pair order: each takes
-	// over its predecessor's history), with the pair's contact area [m^2].
-	void storePair(Step& step, int a, int b, const PairContacts& pair, double area);
+	// After a chunk's pair loop, in pair order: its counts, the found pairs'
+	// entrances, where each one's contacts go (pairFirst_, from the store's
+	// contact firstContact on: the chunk's first), the store's contacts
+	// trimmed or grown to the chunk's end, and contactsPerPair_.
+	void takeChunk(Step& step, int begin, int count, int firstContact);
+	// A found pair's sub-contacts, into the store's contacts from `first` on
+	// (each takes over its predecessor's history), with the pair's contact
+	// area [m^2], prepared for the solver; returns how many have friction.
+	long storePair(Step& step, int a, int b, const PairContacts& pair, double area, int first);
 	static double contactArea(const PairContacts& pair);
-	// The springs and linearised gaps of the store's contacts from `first` on.
-	void prepareContacts(Step& step, int first);
 
 	std::vector<std::pair<int, int>> pairs_;
 	// The narrow phase runs the candidate pairs in chunks (kPairChunk in
@@ -110,6 +113,8 @@ private:
 	std::vector<std::vector<char>> internalFaces_;
 	int internalFacesBlocks_ = -1;  // block count when internalFaces_ was computed
 	std::vector<double> pairArea_;  // per pair of the chunk, its contact area [m^2] (found pairs)
+	double contactsPerPair_ = 1;    // the last chunk's contacts per candidate pair (its estimate for the next)
+	std::vector<int> pairFirst_;    // per found pair of the chunk, where its contacts start among the chunk's
 };
 
 }  // namespace dda

@@ -2,6 +2,8 @@
 // terms are EnergyAccount's in IntegratorSettings.hpp).
 #include "World.hpp"
 
+#include "StepClock.hpp"
+
 namespace dda {
 
 EnergyAccount World::energy() const {
@@ -37,22 +39,35 @@ void World::accountStep(const IntegratorSettings& settings) {
 	// force's work is minus the change of the strain energy minus (2 gamma
 	// - 1) times its Bregman divergence (the damping; 0 for average
 	// acceleration), a fixed point's F(0) (1 - gamma) + F(D) gamma.
+	// Each block's damping terms are computed on any thread, then added in
+	// block order (the loads' terms, few, in the same pass).
 	const double gamma = settings.newmarkGamma;
 	const std::vector<int>& moving = openClose_.moving();
 	const int n = static_cast<int>(moving.size());
+	blockEnergies_.resize(moving.size());
+#pragma omp parallel for schedule(static) if (n >= kMinBlocksForThreads)
 	for (int k = 0; k < n; ++k) {
 		const Block& block = blocks_[moving[k]];
 		const Vector12& D = openClose_.solution(k);
-		if (settings.velocityRatio < 1) {
-			// Velocities scaled by velocityRatio at the step's start: the
-			// kinetic energy removed is damping.
-			const double ratio = settings.velocityRatio;
-			energy_.damping += (1 - ratio * ratio) * kineticEnergy(block, block.velocity);
-		}
-		if (!block.rigid) {
+		BlockStepEnergy& e = blockEnergies_[k];
+		// Velocities scaled by velocityRatio at the step's start: the
+		// kinetic energy removed is damping.
+		const double ratio = settings.velocityRatio;
+		e.scaling = ratio < 1 ? (1 - ratio * ratio) * kineticEnergy(block, block.velocity) : 0;
+		e.strained = !block.rigid;
+		if (e.strained) {
 			const Vector6 strain = D.segment<6>(6);
-			energy_.damping += (2 * gamma - 1) * 0.5 * block.referenceVolume() * strain.dot(block.elasticity() * strain);
+			e.strain = (2 * gamma - 1) * 0.5 * block.referenceVolume() * strain.dot(block.elasticity() * strain);
 		}
+		e.loaded = !block.loads.empty() || !block.fixedPoints.empty();
+	}
+	for (int k = 0; k < n; ++k) {
+		const BlockStepEnergy& e = blockEnergies_[k];
+		if (settings.velocityRatio < 1) energy_.damping += e.scaling;
+		if (e.strained) energy_.damping += e.strain;
+		if (!e.loaded) continue;
+		const Block& block = blocks_[moving[k]];
+		const Vector12& D = openClose_.solution(k);
 		for (const PointLoad& load : block.loads)
 			energy_.loads += load.force.dot(displacementAt(load.position - block.centroid, D));
 		for (const FixedPoint& point : block.fixedPoints) {
@@ -62,12 +77,20 @@ void World::accountStep(const IntegratorSettings& settings) {
 		}
 	}
 	// Contacts: their springs' energy at the start of this step in the
-	// accepted states against what the last step ended with.
-	double start = 0, end = 0;
-	for (const Contact& contact : store_.contacts()) {
+	// accepted states against what the last step ended with. Each contact's
+	// terms are computed on any thread, then summed in contact order.
+	const std::vector<Contact>& contacts = store_.contacts();
+	const int contactCount = static_cast<int>(contacts.size());
+	contactEnergies_.resize(contacts.size());
+#pragma omp parallel for schedule(static) if (contactCount >= kMinContactsForThreads)
+	for (int c = 0; c < contactCount; ++c) {
+		const Contact& contact = contacts[c];
 		const int bi = contact.bodyI, bj = contact.bodyJ;
-		const ContactStepEnergy e = contactStepEnergy(contact, blocks_[bi], blocks_[bj], openClose_.solutionOf(bi),
-		                                              openClose_.solutionOf(bj));
+		contactEnergies_[c] = contactStepEnergy(contact, blocks_[bi], blocks_[bj], openClose_.solutionOf(bi),
+		                                        openClose_.solutionOf(bj));
+	}
+	double start = 0, end = 0;
+	for (const ContactStepEnergy& e : contactEnergies_) {
 		start += e.start;
 		end += e.end;
 		energy_.damping += e.damping;

@@ -184,7 +184,8 @@ World::MemoryUse World::memoryUse() const {
 	use.collider = collider_->memoryBytes();
 	use.contacts = store_.memoryBytes();
 	use.narrowPhase = detection_.memoryBytes();
-	use.solver = openClose_.memoryBytes() + capacityBytes(motions_);
+	use.solver = openClose_.memoryBytes() + capacityBytes(motions_) + capacityBytes(blockEnergies_) +
+	             capacityBytes(contactEnergies_);
 	return use;
 }
 

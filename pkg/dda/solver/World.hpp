@@ -162,6 +162,16 @@ private:
 	OpenCloseIteration openClose_;  // the step's moving blocks, system and iteration
 	TimeStepControl timeStep_;
 	std::vector<BlockMotion> motions_;  // moveContactsAndBlocks' work array
+	// accountStep's work arrays: per moving block its damping terms (the
+	// kinetic energy velocityRatio removes; the strain's Bregman divergence,
+	// when it is strained) and whether it has loads or fixed points; per
+	// contact its terms.
+	struct BlockStepEnergy {
+		double scaling = 0, strain = 0;
+		bool strained = false, loaded = false;
+	};
+	std::vector<BlockStepEnergy> blockEnergies_;
+	std::vector<ContactStepEnergy> contactEnergies_;
 	std::vector<Block> blocks_;
 	TopologyPool topologies_;  // the blocks' shared topologies
 	StepStatistics stats_;

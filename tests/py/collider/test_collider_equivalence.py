@@ -112,8 +112,9 @@ def test_slender_deposit_every_strategy_finds_the_all_pairs_contacts(scene):
 
 def _deposit(seed, collider, threads, steps=25):
     """1,100 slender blocks in two layers, turned a little at random (seeded), landing on a floor:
-    above the threshold at which the core's per-block loops and MSC's shell update run threaded.
-    Returns the contact set of every step and the final corners."""
+    above the threshold at which the core's per-block loops, MSC's shell update and the sync's
+    preparation run threaded. Returns the contact set of every step, the final corners, and what
+    YADE's bodies show after every step (O.step() syncs each one)."""
     import math
     import random
     from helpers import box, rotate
@@ -130,24 +131,29 @@ def _deposit(seed, collider, threads, steps=25):
         O.bodies.append(ddaBlock(corners, velocity=(0, 0, -0.2)))
     O.engines = [DDAIntegrator(dt=1e-3, maxDisplacement=0.005, gravity=(0, 0, -9.81), collider=collider,
                                threads=threads)]
-    sets = []
+    sets, shown = [], []
     for _ in range(steps):
         O.step()
         sets.append(sorted((c.id1, c.id2, c.kind, c.type, c.state, tuple(c.point), c.gap) for c in contacts()))
+        shown.append([(tuple(b.state.pos), tuple(b.state.ori[i] for i in range(4)), tuple(b.state.vel),
+                       tuple(b.state.angVel), tuple(tuple(v) for v in b.shape.v)) for b in O.bodies])
     assert math.isfinite(stats()['maxDisplacement'])
-    return sets, [tuple(v) for b in O.bodies for v in __import__('yade_dda').block(b).vertices]
+    return sets, [tuple(v) for b in O.bodies for v in __import__('yade_dda').block(b).vertices], shown
 
 
 @pytest.mark.parametrize('seed', [11])
 def test_threads_change_no_contact_and_no_motion_of_a_deposit(scene, seed):
     """MSC and DESS on 1 and 2 threads give bitwise the same contacts at every step and the same
-    corners, and those contacts are AllPairs'."""
+    corners, and those contacts are AllPairs'; YADE's bodies show bitwise the same states and
+    vertices after every step on 1 and 2 threads."""
     print('seed', seed)
-    reference, corners = _deposit(seed, 'AllPairs', 1)
+    reference, corners, shownOnOne = _deposit(seed, 'AllPairs', 1)
     assert sum(len(s) for s in reference) > 1000, 'the deposit makes contacts'
     for collider in ('MSC', 'DESS'):
         for threads in (1, 2):
-            found, foundCorners = _deposit(seed, collider, threads)
+            found, foundCorners, shown = _deposit(seed, collider, threads)
             for step, (a, b) in enumerate(zip(reference, found)):
                 assert a == b, '%s on %d threads differs from AllPairs at step %d' % (collider, threads, step)
             assert foundCorners == corners, '%s on %d threads moved the blocks differently' % (collider, threads)
+            for step, (a, b) in enumerate(zip(shownOnOne, shown)):
+                assert a == b, "YADE's bodies under %s on %d threads differ at step %d" % (collider, threads, step)
