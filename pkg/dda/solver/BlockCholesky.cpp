@@ -8,20 +8,9 @@
 
 #include <algorithm>
 
-#include <omp.h>
-
 namespace dda {
 
 namespace {
-
-// A column's 12x12 products (about 0.16 us each with AVX2) below which its
-// updates run on one thread: about 80 us of work. A parallel region costs a
-// few microseconds on free cores, but on a loaded machine each one can wait
-// a scheduler slice for a descheduled thread (a dense 66-block factorisation
-// with a region for every column of 96 products or more: 6.7 ms on 2 threads
-// against 9.8 on one, and 184 ms once with the other core busy), so only
-// long columns get one.
-constexpr long kMinProductsForThreads = 512;
 
 // The entry of row `row` in column `column`'s sorted rows.
 int entryOf(const std::vector<int>& columnStart, const std::vector<int>& rows, int column, int row) {
@@ -120,32 +109,28 @@ bool BlockCholesky::factorize(const Matrix12* diagonal, const Matrix12* offDiago
 			if (sizes_[j] != kBlockDofs) factor_[p].rightCols<6>().setZero();
 		}
 	}
-	// Column j's updates write distinct blocks (the diagonal block of each of
-	// its rows, and L_ik for each pair of its rows i > k), each once, so its
-	// rows can be shared among threads: every block sees the same operations
-	// in the same order whatever the thread count. Threads only for a column
-	// with enough products to pay for a parallel region, and not inside one
-	// (components are solved in parallel when there are many).
-	const bool threads = omp_get_max_threads() > 1 && !omp_in_parallel();
+	// Column j's updates: row p's targets (its diagonal block, and L_ik for
+	// each earlier row k of the column) start at its own offset of the
+	// column's update targets. (Sharing a column's rows among threads, each
+	// block written by one, gives the same bits, and took 9.4 -> 6.2 ms for a
+	// dense 66-block factorisation on 2 threads; but on the sparser factors of
+	// piles a region per long column cost more than it saved, 2.9 -> 3.3 ms for
+	// 49 blocks at 30 %, and the 70-block drop ran slower on 2 threads than on
+	// one: a worker that falls asleep between regions is woken for each. So
+	// the factorisation is sequential; components run in parallel when there
+	// are many.)
 	for (int j = 0; j < blocks; ++j) {
 		pivots_[j].compute(diagonal_[j]);
 		if (pivots_[j].info() != Eigen::Success) return false;
 		const int first = columnStart_[j], last = columnStart_[j + 1];
 		const int* targets = updateTarget_.data() + updateStart_[j];
-		const long products = updateStart_[j + 1] - updateStart_[j] + (last - first);
-#pragma omp parallel if (threads && products >= kMinProductsForThreads)
-		{
-#pragma omp for schedule(static)
-			for (int p = first; p < last; ++p) pivots_[j].matrixU().solveInPlace<Eigen::OnTheRight>(factor_[p]);
-			// Row p makes p - first + 1 products: the longest rows first.
-#pragma omp for schedule(dynamic, 1)
-			for (int p = last - 1; p >= first; --p) {
-				const Matrix12& lij = factor_[p];
-				const long row = p - first;
-				const int* target = targets + row * (row - 1) / 2;
-				subtractProductTransposed(diagonal_[rows_[p]], lij, lij);
-				for (int q = first; q < p; ++q) subtractProductTransposed(factor_[target[q - first]], lij, factor_[q]);
-			}
+		for (int p = first; p < last; ++p) pivots_[j].matrixU().solveInPlace<Eigen::OnTheRight>(factor_[p]);
+		for (int p = first; p < last; ++p) {
+			const Matrix12& lij = factor_[p];
+			const long row = p - first;
+			const int* target = targets + row * (row - 1) / 2;
+			subtractProductTransposed(diagonal_[rows_[p]], lij, lij);
+			for (int q = first; q < p; ++q) subtractProductTransposed(factor_[target[q - first]], lij, factor_[q]);
 		}
 	}
 	return true;

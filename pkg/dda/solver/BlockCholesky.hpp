@@ -16,9 +16,8 @@
 // Numeric factorisation (right-looking, column by column in elimination
 // order): L_jj = chol(A_jj); L_ij = A_ij L_jj^-T for the rows i of column j;
 // then A_ik -= L_ij L_kj^T for every pair of rows i >= k of column j. The
-// arithmetic of each block is sequential and fixed by the pattern (a
-// column's rows are shared among threads, each block written by one): the
-// same matrix gives bitwise the same factor, whatever the thread count.
+// arithmetic is sequential and fixed by the pattern: the same matrix gives
+// bitwise the same factor, whatever the thread count.
 //
 // Rigid blocks (6 unknowns) keep the 12x12 layout: their strain rows and
 // columns are replaced by those of the identity, with no coupling, and their

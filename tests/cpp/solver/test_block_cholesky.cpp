@@ -9,11 +9,8 @@
 
 #include <Eigen/Dense>
 
-#include <omp.h>
-
 #include <random>
 #include <set>
-#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -149,32 +146,4 @@ TEST(BlockCholesky, RefusesAMatrixThatIsNotPositiveDefinite) {
 	EXPECT_FALSE(cholesky.factorize(p.diagonal.data(), p.offDiagonal.data(), p.sizes.data()));
 	p.diagonal[2](5, 5) = -1;   // and one that is not even positive on its diagonal
 	EXPECT_FALSE(cholesky.factorize(p.diagonal.data(), p.offDiagonal.data(), p.sizes.data()));
-}
-
-// A column's updates are shared among threads when it has enough of them:
-// the solution must be bitwise the one-thread solution for 1 to 4 threads,
-// on dense clusters (where columns are long) and sparse ones.
-TEST(BlockCholesky, SolutionDoesNotDependOnTheThreadCount) {
-	const int previous = omp_get_max_threads();
-	unsigned seed = 500;
-	for (const auto& [blocks, density, rigid] : {std::tuple<int, double, double>{66, 1.0, 0.0}, {50, 0.4, 0.2},
-	                                              {80, 0.05, 0.0}}) {
-		const Problem p = randomProblem(++seed, blocks, density, rigid);
-		std::vector<Vector12> reference;
-		for (int threads = 1; threads <= 4; ++threads) {
-			omp_set_num_threads(threads);
-			BlockCholesky cholesky;
-			cholesky.analyse(p.blocks, p.links);
-			ASSERT_TRUE(cholesky.factorize(p.diagonal.data(), p.offDiagonal.data(), p.sizes.data()));
-			std::vector<Vector12> x = p.rhs;
-			cholesky.solve(x.data());
-			if (threads == 1) {
-				reference = x;
-				continue;
-			}
-			for (int k = 0; k < p.blocks; ++k)
-				ASSERT_EQ(x[k], reference[k]) << "seed " << seed << ", " << threads << " threads, block " << k;
-		}
-	}
-	omp_set_num_threads(previous);
 }
