@@ -5,6 +5,7 @@
 #pragma once
 
 #include "dda/collider/Collider.hpp"
+#include "dda/collider/ColliderFactory.hpp"
 #include "dda/contact/PairDetection.hpp"
 #include "dda/solver/World.hpp"
 
@@ -17,6 +18,7 @@
 #include <memory>
 #include <random>
 #include <set>
+#include <string>
 #include <tuple>
 #include <vector>
 
@@ -113,6 +115,74 @@ inline IntegratorSettings gravitySettings(bool reuse) {
 	settings.gravity = Vector3(0, 0, -9.81);
 	settings.maxTimeStep = 2e-3;
 	settings.reuseCandidatePairs = reuse;
+	return settings;
+}
+
+// A floor and 12 L's, T's (three or four unit cubes) and cubes, turned at
+// random, 2 x 2 per layer 4 m apart (no two overlap: a T reaches 1.7 m from
+// its centre), dropped; Young's modulus `young`; `concave` false
+// adds every part of an L or T as a convex block of its own. `roofs` puts
+// roofs in place of the L's: two parallelepipeds 1 m x 1 m x 0.5 m sharing
+// their seam face, each sheared down by 0.2 m away from it, so the top faces
+// meet at a ridge (11 degrees) and the bottom ones in a valley: a face's
+// plane runs on past the ridge above the other part, outside the block.
+inline World randomConcavePile(unsigned seed, bool concave, double young, bool roofs = false,
+                               const std::string& collider = "DESS") {
+	std::mt19937 rng(seed);
+	std::uniform_real_distribution<double> unit(0, 1);
+	World world;
+	Material rock{2600, young, 0.25};
+	rock.frictionAngle = 0.4;
+	world.addBlock(orientedBox(Vector3(4, 4, -0.5), Vector3(8, 8, 0.5), Matrix3::Identity()), rock, true);
+	for (int k = 0; k < 12; ++k) {
+		const Vector3 centre(2 + 4 * (k % 2) + 0.3 * unit(rng), 2 + 4 * (k / 2 % 2) + 0.3 * unit(rng),
+		                     2 + 3.6 * (k / 4) + 0.3 * unit(rng));
+		const Matrix3 R = k % 3 == 2 ? Matrix3(Eigen::AngleAxisd(6.3 * unit(rng), Vector3::UnitZ()).toRotationMatrix())
+		                             : Matrix3(randomRotation(rng));
+		if (k % 3 == 2) {
+			world.addBlock(orientedBox(centre, Vector3(0.5, 0.5, 0.5), R), rock, false);
+			continue;
+		}
+		if (roofs && k % 3 == 0) {
+			std::vector<std::vector<Vector3>> parts;
+			for (const double side : {-1.0, 1.0}) {
+				std::vector<Vector3> corners;
+				for (const double x : {0.0, side})
+					for (const double y : {-0.5, 0.5})
+						for (const double z : {-0.25, 0.25})
+							corners.push_back(centre + R * Vector3(x, y, z - 0.2 * std::abs(x)));
+				parts.push_back(corners);
+			}
+			world.addConcaveBlock(parts, rock, false, false);
+			continue;
+		}
+		std::vector<Vector3> offsets = {Vector3(0, 0, 0), Vector3(1, 0, 0), Vector3(0, 1, 0)};
+		if (k % 3 == 1) offsets.push_back(Vector3(-1, 0, 0));
+		std::vector<std::vector<Vector3>> parts;
+		for (const Vector3& o : offsets) {
+			std::vector<Vector3> corners = boxPoints(o - Vector3(0.5, 0.5, 0.5), o + Vector3(0.5, 0.5, 0.5));
+			for (Vector3& x : corners) x = centre + R * x;
+			parts.push_back(corners);
+		}
+		if (concave)
+			world.addConcaveBlock(parts, rock, false, k % 2 == 0);
+		else
+			for (const auto& part : parts) world.addBlock(part, rock, false, k % 2 == 0);
+	}
+	world.setCollider(makeCollider(collider));
+	return world;
+}
+
+// The steps randomConcavePile is run with: gravity, 2 ms, one thread,
+// average acceleration (beta 1/4, gamma 1/2: the account balances to
+// round-off without Shi's numerical damping).
+inline IntegratorSettings concavePileSettings() {
+	IntegratorSettings settings;
+	settings.gravity = Vector3(0, 0, -9.81);
+	settings.maxTimeStep = 2e-3;
+	settings.threads = 1;
+	settings.newmarkGamma = 0.5;
+	settings.newmarkBeta = 0.25;
 	return settings;
 }
 

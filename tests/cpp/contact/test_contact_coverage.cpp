@@ -76,58 +76,6 @@ int bodyOf(const World& world, int part) {
 	return b.body >= 0 ? b.body : part;
 }
 
-// The pile of test_concave_blocks.cpp (a floor, 12 L's, T's and cubes turned
-// at random, 2 x 2 per layer), with Young's modulus `young`; `concave` false
-// adds every part of an L or T as a convex block of its own. `roofs` puts
-// roofs in place of the L's: two parallelepipeds 1 m x 1 m x 0.5 m sharing
-// their seam face, each sheared down by 0.2 m away from it, so the top faces
-// meet at a ridge (11 degrees) and the bottom ones in a valley: a face's
-// plane runs on past the ridge above the other part, outside the block.
-World randomPile(unsigned seed, bool concave, double young, bool roofs = false) {
-	std::mt19937 rng(seed);
-	std::uniform_real_distribution<double> unit(0, 1);
-	World world;
-	Material rock{2600, young, 0.25};
-	rock.frictionAngle = 0.4;
-	world.addBlock(orientedBox(Vector3(4, 4, -0.5), Vector3(8, 8, 0.5), Matrix3::Identity()), rock, true);
-	for (int k = 0; k < 12; ++k) {
-		const Vector3 centre(2 + 4 * (k % 2) + 0.3 * unit(rng), 2 + 4 * (k / 2 % 2) + 0.3 * unit(rng),
-		                     2 + 3.6 * (k / 4) + 0.3 * unit(rng));
-		const Matrix3 R = k % 3 == 2 ? Matrix3(Eigen::AngleAxisd(6.3 * unit(rng), Vector3::UnitZ()).toRotationMatrix())
-		                             : Matrix3(randomRotation(rng));
-		if (k % 3 == 2) {
-			world.addBlock(orientedBox(centre, Vector3(0.5, 0.5, 0.5), R), rock, false);
-			continue;
-		}
-		if (roofs && k % 3 == 0) {
-			std::vector<std::vector<Vector3>> parts;
-			for (const double side : {-1.0, 1.0}) {
-				std::vector<Vector3> corners;
-				for (const double x : {0.0, side})
-					for (const double y : {-0.5, 0.5})
-						for (const double z : {-0.25, 0.25}) corners.push_back(centre + R * Vector3(x, y, z - 0.2 * std::abs(x)));
-				parts.push_back(corners);
-			}
-			world.addConcaveBlock(parts, rock, false, false);
-			continue;
-		}
-		std::vector<Vector3> offsets = {Vector3(0, 0, 0), Vector3(1, 0, 0), Vector3(0, 1, 0)};
-		if (k % 3 == 1) offsets.push_back(Vector3(-1, 0, 0));
-		std::vector<std::vector<Vector3>> parts;
-		for (const Vector3& o : offsets) {
-			std::vector<Vector3> corners = boxPoints(o - Vector3(0.5, 0.5, 0.5), o + Vector3(0.5, 0.5, 0.5));
-			for (Vector3& x : corners) x = centre + R * x;
-			parts.push_back(corners);
-		}
-		if (concave)
-			world.addConcaveBlock(parts, rock, false, k % 2 == 0);
-		else
-			for (const auto& part : parts) world.addBlock(part, rock, false, k % 2 == 0);
-	}
-	world.setCollider(makeCollider("DESS"));
-	return world;
-}
-
 // What the oracle counts over a run.
 struct Coverage {
 	long insideCorners = 0;        // corner-in-part instances deeper than the tolerance
@@ -154,12 +102,7 @@ struct Coverage {
 // Steps the pile and checks, at every step, the start-of-step corners
 // against the contacts detected from them.
 Coverage measure(World& world, int steps, double tolerance) {
-	IntegratorSettings settings;
-	settings.gravity = Vector3(0, 0, -9.81);
-	settings.maxTimeStep = 2e-3;
-	settings.threads = 1;
-	settings.newmarkGamma = 0.5;
-	settings.newmarkBeta = 0.25;
+	const IntegratorSettings settings = concavePileSettings();
 	Coverage result;
 	const int n = world.blockCount();
 	// Each part's largest corner displacement in the last step [m].
@@ -314,7 +257,7 @@ TEST(ContactCoverage, CornersInsideAnotherBlockHaveContacts) {
 	for (const unsigned seed : seeds)
 		for (const int kind : {0, 1, 2})  // concave, convex, roofs
 			for (const double young : {1e8, 1e10}) {
-				World world = randomPile(seed, kind != 1, young, kind == 2);
+				World world = randomConcavePile(seed, kind != 1, young, kind == 2);
 				const Coverage c = measure(world, 700, 2e-6);
 				char name[64];
 				std::snprintf(name, sizeof name, "%s E=%.0e", kind == 0 ? "concave" : kind == 1 ? "convex" : "roofs",

@@ -177,37 +177,11 @@ ContactKeys keysOf(const World& world) {
 }
 
 // Random L's and T's (three or four unit cubes, turned) and cubes dropped on a
-// floor: every strategy's contacts equal AllPairs' at every step, no contact
-// joins two parts of one block, and the account balances.
+// floor (TestScenes.hpp's randomConcavePile, E = 1e8 Pa): every strategy's
+// contacts equal AllPairs' at every step, no contact joins two parts of one
+// block, and the account balances.
 World randomConcaveScene(unsigned seed, const std::string& collider) {
-	std::mt19937 rng(seed);
-	std::uniform_real_distribution<double> unit(0, 1);
-	World world;
-	Material rock{2600, 1e8, 0.25};
-	rock.frictionAngle = 0.4;
-	world.addBlock(orientedBox(Vector3(4, 4, -0.5), Vector3(8, 8, 0.5), Matrix3::Identity()), rock, true);
-	for (int k = 0; k < 12; ++k) {
-		// A grid of 2 x 2 per layer, 4 m apart (no two blocks overlap: a T reaches 1.7 m from its centre).
-		const Vector3 centre(2 + 4 * (k % 2) + 0.3 * unit(rng), 2 + 4 * (k / 2 % 2) + 0.3 * unit(rng),
-		                     2 + 3.6 * (k / 4) + 0.3 * unit(rng));
-		const Matrix3 R = k % 3 == 2 ? Matrix3(Eigen::AngleAxisd(6.3 * unit(rng), Vector3::UnitZ()).toRotationMatrix())
-		                             : Matrix3(randomRotation(rng));
-		if (k % 3 == 2) {  // a cube
-			world.addBlock(orientedBox(centre, Vector3(0.5, 0.5, 0.5), R), rock, false);
-			continue;
-		}
-		std::vector<Vector3> offsets = {Vector3(0, 0, 0), Vector3(1, 0, 0), Vector3(0, 1, 0)};
-		if (k % 3 == 1) offsets.push_back(Vector3(-1, 0, 0));  // a T
-		std::vector<std::vector<Vector3>> parts;
-		for (const Vector3& o : offsets) {
-			std::vector<Vector3> corners = boxPoints(o - Vector3(0.5, 0.5, 0.5), o + Vector3(0.5, 0.5, 0.5));
-			for (Vector3& x : corners) x = centre + R * x;
-			parts.push_back(corners);
-		}
-		world.addConcaveBlock(parts, rock, false, k % 2 == 0);
-	}
-	world.setCollider(makeCollider(collider));
-	return world;
+	return randomConcavePile(seed, true, 1e8, false, collider);
 }
 
 TEST(ConcaveBlocks, EveryColliderFindsAllPairsContactsAndTheAccountBalances) {
@@ -216,12 +190,7 @@ TEST(ConcaveBlocks, EveryColliderFindsAllPairsContactsAndTheAccountBalances) {
 		std::vector<World> worlds;
 		const std::vector<std::string> names = {"AllPairs", "DESS", "NBS", "MSC"};
 		for (const std::string& name : names) worlds.push_back(randomConcaveScene(seed, name));
-		IntegratorSettings settings;
-		settings.gravity = Vector3(0, 0, -9.81);
-		settings.maxTimeStep = 2e-3;
-		settings.threads = 1;
-		settings.newmarkGamma = 0.5;
-		settings.newmarkBeta = 0.25;
+		const IntegratorSettings settings = concavePileSettings();
 		// The account's conserved sum (IntegratorSettings.hpp): its terms less
 		// the loads' work and what contact detection added (contactChanges).
 		auto account = [](const EnergyAccount& e) {
