@@ -33,7 +33,7 @@
 // contacts whose state changed (a few rank-one terms each), so a
 // component's matrix stays close to the one factorised at its first solve.
 // When refinement is on (IntegratorSettings::refineSolves) a later solve of a
-// component whose blocks are exactly those of a component factorised earlier
+// component (kMinRefineBlocks or more) whose blocks are exactly those of a component factorised earlier
 // in the same attempt runs preconditioned conjugate gradients with that
 // factor, the latest one (refineComponent): with the exact factor of K_old as the
 // preconditioner, the iteration matrix is K_old^-1 K = I + K_old^-1 dK, whose
