@@ -74,8 +74,7 @@ void BlockCholesky::analyse(int blocks, const std::vector<std::pair<int, int>>& 
 		linkTarget_.push_back(b > a ? entry : -1 - entry);
 	}
 	updateTarget_.clear();
-	updateStart_.assign(blocks + 1, 0);
-	for (int j = 0; j < blocks; ++j, updateStart_[j] = static_cast<long>(updateTarget_.size()))
+	for (int j = 0; j < blocks; ++j)
 		for (int p = columnStart_[j]; p < columnStart_[j + 1]; ++p)
 			for (int q = columnStart_[j]; q < p; ++q)
 				updateTarget_.push_back(entryOf(columnStart_, rows_, rows_[q], rows_[p]));
@@ -109,28 +108,24 @@ bool BlockCholesky::factorize(const Matrix12* diagonal, const Matrix12* offDiago
 			if (sizes_[j] != kBlockDofs) factor_[p].rightCols<6>().setZero();
 		}
 	}
-	// Column j's updates: row p's targets (its diagonal block, and L_ik for
-	// each earlier row k of the column) start at its own offset of the
-	// column's update targets. (Sharing a column's rows among threads, each
-	// block written by one, gives the same bits, and took 9.4 -> 6.2 ms for a
-	// dense 66-block factorisation on 2 threads; but on the sparser factors of
-	// piles a region per long column cost more than it saved, 2.9 -> 3.3 ms for
-	// 49 blocks at 30 %, and the 70-block drop ran slower on 2 threads than on
-	// one: a worker that falls asleep between regions is woken for each. So
-	// the factorisation is sequential; components run in parallel when there
-	// are many.)
+	// The updates in the order their targets were listed. (Sharing a column's
+	// rows among threads, each block written by one, gives the same bits, and
+	// took 9.4 -> 6.2 ms for a dense 66-block factorisation on 2 threads; but
+	// on the sparser factors of piles a region per long column cost more than
+	// it saved, 2.9 -> 3.3 ms for 49 blocks at 30 %, and the 70-block drop ran
+	// slower on 2 threads than on one: a worker that falls asleep between
+	// regions is woken for each. So the factorisation is sequential;
+	// components run in parallel when there are many.)
+	const int* target = updateTarget_.data();
 	for (int j = 0; j < blocks; ++j) {
 		pivots_[j].compute(diagonal_[j]);
 		if (pivots_[j].info() != Eigen::Success) return false;
 		const int first = columnStart_[j], last = columnStart_[j + 1];
-		const int* targets = updateTarget_.data() + updateStart_[j];
 		for (int p = first; p < last; ++p) pivots_[j].matrixU().solveInPlace<Eigen::OnTheRight>(factor_[p]);
 		for (int p = first; p < last; ++p) {
 			const Matrix12& lij = factor_[p];
-			const long row = p - first;
-			const int* target = targets + row * (row - 1) / 2;
 			subtractProductTransposed(diagonal_[rows_[p]], lij, lij);
-			for (int q = first; q < p; ++q) subtractProductTransposed(factor_[target[q - first]], lij, factor_[q]);
+			for (int q = first; q < p; ++q) subtractProductTransposed(factor_[*target++], lij, factor_[q]);
 		}
 	}
 	return true;
@@ -158,7 +153,7 @@ void BlockCholesky::solve(Vector12* x) const {
 
 std::size_t BlockCholesky::memoryBytes() const {
 	return capacityBytes(inverse_) + capacityBytes(columnStart_) + capacityBytes(rows_) +
-	       capacityBytes(linkTarget_) + capacityBytes(updateTarget_) + capacityBytes(updateStart_) + capacityBytes(sizes_) + capacityBytes(factor_) +
+	       capacityBytes(linkTarget_) + capacityBytes(updateTarget_) + capacityBytes(sizes_) + capacityBytes(factor_) +
 	       capacityBytes(diagonal_) + capacityBytes(pivots_);
 }
 

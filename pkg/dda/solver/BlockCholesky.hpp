@@ -62,7 +62,6 @@ private:
 	std::vector<int> columnStart_, rows_;  // per column (place), its rows (places) below the diagonal, ascending
 	std::vector<int> linkTarget_;          // per link: its entry of factor_ (signed: -1 - entry when transposed)
 	std::vector<int> updateTarget_;        // per (column j, row i, row k < i of j): the entry of L_ik
-	std::vector<long> updateStart_;        // per column: its first entry of updateTarget_
 	std::vector<int> sizes_;               // per place
 	std::vector<Matrix12> factor_;         // L_ij, per entry of rows_
 	std::vector<Matrix12> diagonal_;       // per place: A_jj, then L_jj
