@@ -56,8 +56,33 @@ bool parallelDirections(const Vector3& da, const Vector3& db, double sinToleranc
 inline constexpr double kUnitTripleRoundoff = 1e-13;
 
 // The sign of x . (y x z) when the filter cannot tell (|approx| within the
-// round-off bound): exact, by CGAL.
+// round-off bound): exact. First tryTripleSign (below), then CGAL.
 int unitOrientationExact(const Vector3& x, const Vector3& y, const Vector3& z);
+
+// The sign of x . (y x z) from a round-off bound of the operands' own
+// magnitudes, or 0 when it cannot tell (then only an exact computation can).
+// kUnitTripleRoundoff bounds the error for unit vectors of any direction;
+// where the triple product is tiny because the vectors' components are
+// (normals of faces aligned with the axes, turned a little: products of
+// 1e-14 components), the error is as tiny, and this bound says so.
+//
+// Bound (u = 2^-53, rounding to nearest, no underflow or overflow; the
+// products and differences below, fused or not): with a_i = |y_j z_k| +
+// |y_k z_j| ((i, j, k) cyclic) and P = sum_i |x_i| a_i, the computed
+// c_i = y_j z_k - y_k z_j is within gamma_2 a_i of the exact one (a product
+// and a difference), and the computed d = sum_i x_i c_i within gamma_3
+// sum_i |x_i| |c_i| <= gamma_3 (1 + gamma_2) P of sum_i x_i c_i
+// (gamma_n = n u / (1 - n u), Higham's inner-product bound); so
+// |d - x . (y x z)| <= (gamma_2 + gamma_3 + gamma_2 gamma_3) P < 6 u P. The
+// computed P~ (sums and products of non-negative numbers, five roundings on
+// any path) is at least P (1 - u)^5, so 6 u P < 7 u P~ < 2^-50 P~, a product
+// by a power of two, exact. |d| > 2^-50 P~ therefore leaves the exact value
+// on d's side of zero. Range: the function declines unless every component
+// is within 2^64 (nothing overflows) and P~ >= 2^-900; a product that
+// underflows then adds at most 2^-1075 (times |x_i| <= 2^64, some ten of
+// them: below 2^-1000), far less than the u P~ >= 2^-953 between 7 u P~ and
+// the bound.
+int tryTripleSign(const Vector3& x, const Vector3& y, const Vector3& z);
 
 // Exact sign of the triple product x . (y x z) of three unit vectors, given
 // its double value `approx`. Inline: the narrow phase's edge axes call it a
