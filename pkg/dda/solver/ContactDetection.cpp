@@ -102,7 +102,7 @@ void ContactDetection::detect(const std::vector<Block>& blocks, Collider& collid
 	const int pairCount = static_cast<int>(pairs_.size());
 	// Threads by the step's pair count, not the chunk's: a small scene stays
 	// serial, and a large one's chunks (all but perhaps its last) are large.
-	Step step{blocks, collider, store, settings, frictionScale, stats, pairCount >= kMinBlocksForThreads};
+	Step step{blocks, collider, store, settings, frictionScale, stats, pairCount >= kMinPairsForThreads};
 	startChunks(blocks);
 	for (int begin = 0, chunk = 0; begin < pairCount; begin += kPairChunk, ++chunk)
 		detectChunk(step, begin, std::min(kPairChunk, pairCount - begin), chunk);

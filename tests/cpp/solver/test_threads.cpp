@@ -3,7 +3,8 @@
 // account and the step's counters. The scene is large enough for every threaded loop of the
 // step to run threaded (kMinBlocksForThreads blocks, pairs and MSC's frame
 // tests; kMinContactsForThreads contacts), so a loop whose result depended on
-// how its items were split, or on the order threads finish, shows here.
+// how its items were split, or on the order threads finish, shows here; a
+// smaller one runs the narrow phase alone threaded (kMinPairsForThreads).
 #include "TestScenes.hpp"
 #include "dda/collider/ColliderFactory.hpp"
 #include "dda/core/StateStream.hpp"
@@ -84,17 +85,25 @@ void expectSameCounters(const StepStatistics& one, const StepStatistics& two, in
 	EXPECT_EQ(one.blocksResearched, two.blocksResearched) << "step " << step;
 }
 
-// Steps the scene on 1 and on 2 threads side by side, comparing after each step.
-void expectTwoThreadsStepAsOne(const std::string& collider) {
-	World one = crossedStacks(collider, 700);
-	World two = crossedStacks(collider, 700);
+// Steps the scene on 1 and on 2 threads side by side, comparing after each
+// step. `stacks` 700: every threaded loop runs threaded; 200: the narrow
+// phase alone (kMinPairsForThreads pairs, fewer than kMinBlocksForThreads
+// blocks and kMinContactsForThreads contacts), a small dense scene's case.
+void expectTwoThreadsStepAsOne(const std::string& collider, int stacks = 700) {
+	World one = crossedStacks(collider, stacks);
+	World two = crossedStacks(collider, stacks);
 	long bondedContacts = 0;
 	for (int step = 1; step <= 12; ++step) {
 		one.step(settingsFor(1));
 		two.step(settingsFor(2));
 		const StepStatistics& s = one.lastStep();
-		ASSERT_GE(s.candidatePairs, kMinBlocksForThreads) << "the narrow phase would run on one thread";
-		ASSERT_GE(s.contacts, kMinContactsForThreads) << "the per-contact loops would run on one thread";
+		ASSERT_GE(s.candidatePairs, kMinPairsForThreads) << "the narrow phase would run on one thread";
+		if (stacks >= 700) {
+			ASSERT_GE(s.candidatePairs, kMinBlocksForThreads);
+			ASSERT_GE(s.contacts, kMinContactsForThreads) << "the per-contact loops would run on one thread";
+		} else {
+			ASSERT_LT(one.blockCount(), kMinBlocksForThreads) << "meant as a small scene";
+		}
 		expectSameCounters(s, two.lastStep(), step);
 		ASSERT_TRUE(physicsOf(one) == physicsOf(two)) << collider << ": 2 threads differ from 1 at step " << step;
 		const EnergyAccount energyOne = one.energy(), energyTwo = two.energy();
@@ -111,5 +120,7 @@ void expectTwoThreadsStepAsOne(const std::string& collider) {
 TEST(ThreadCount, MSCStepsBitwiseAsOnOneThread) { expectTwoThreadsStepAsOne("MSC"); }
 
 TEST(ThreadCount, DESSStepsBitwiseAsOnOneThread) { expectTwoThreadsStepAsOne("DESS"); }
+
+TEST(ThreadCount, SmallSceneNarrowPhaseBitwiseAsOnOneThread) { expectTwoThreadsStepAsOne("MSC", 200); }
 
 }  // namespace dda::testing
