@@ -50,6 +50,22 @@ inline Matrix3x12 displacementMatrix(const Vector3& d) {
 	return T;
 }
 
+// (s T(d))^T g: what a point vector g (a force, a gap's gradient) at offset
+// d from the centroid gives each unknown, scaled by s. The same as
+// (s * displacementMatrix(d).transpose()) * g, each entry's products in the
+// same order, with T's zero entries left out (a sum can then differ only in
+// the sign of a zero).
+inline Vector12 displacementTransposeTimes(const Vector3& d, const Vector3& g, double s) {
+	const double x = s * d.x(), y = s * d.y(), z = s * d.z();
+	const double hx = s * (0.5 * d.x()), hy = s * (0.5 * d.y()), hz = s * (0.5 * d.z());
+	Vector12 out;
+	out << s * g(0), s * g(1), s * g(2),
+	       -z * g(1) + y * g(2), z * g(0) + -x * g(2), -y * g(0) + x * g(1),
+	       x * g(0), y * g(1), z * g(2),
+	       hy * g(0) + hx * g(1), hz * g(1) + hy * g(2), hz * g(0) + hx * g(2);
+	return out;
+}
+
 // Displacement of the point at offset d for the unknowns D (same as T(d) D, cheaper).
 inline Vector3 displacementAt(const Vector3& d, const Vector12& D) {
 	const Vector3 t = D.segment<3>(0), r = D.segment<3>(3);

@@ -114,8 +114,7 @@ LinearizedDistance linearizeNormalDistance(const ContactStencil& stencil, const 
 	for (int k = 0; k < 4; ++k) {
 		const bool ofI = k < nI;
 		const Vector3 offset = q[k] - (ofI ? ci : cj);
-		const Vector12 contribution = scale * (displacementMatrix(offset).transpose() * g[k]);
-		(ofI ? out.ei : out.ej) += contribution;
+		(ofI ? out.ei : out.ej) += displacementTransposeTimes(offset, g[k], scale);
 	}
 	return out;
 }

@@ -121,7 +121,8 @@ bool BlockCholesky::factorize(const Matrix12* diagonal, const Matrix12* offDiago
 		pivots_[j].compute(diagonal_[j]);
 		if (pivots_[j].info() != Eigen::Success) return false;
 		const int first = columnStart_[j], last = columnStart_[j + 1];
-		for (int p = first; p < last; ++p) pivots_[j].matrixU().solveInPlace<Eigen::OnTheRight>(factor_[p]);
+		const Matrix12& ljj = pivots_[j].matrixLLT();
+		for (int p = first; p < last; ++p) solveTransposedLowerOnTheRight(factor_[p], ljj);
 		for (int p = first; p < last; ++p) {
 			const Matrix12& lij = factor_[p];
 			subtractProductTransposed(diagonal_[rows_[p]], lij, lij);
@@ -141,11 +142,11 @@ void BlockCholesky::solve(Vector12* x) const {
 	}
 	for (int j = 0; j < blocks; ++j) {
 		pivots_[j].matrixL().solveInPlace(y[j]);
-		for (int p = columnStart_[j]; p < columnStart_[j + 1]; ++p) y[rows_[p]].noalias() -= factor_[p] * y[j];
+		for (int p = columnStart_[j]; p < columnStart_[j + 1]; ++p) subtractProduct(y[rows_[p]], factor_[p], y[j]);
 	}
 	for (int j = blocks - 1; j >= 0; --j) {
 		for (int p = columnStart_[j]; p < columnStart_[j + 1]; ++p)
-			y[j].noalias() -= factor_[p].transpose() * y[rows_[p]];
+			subtractTransposedProduct(y[j], factor_[p], y[rows_[p]]);
 		pivots_[j].matrixU().solveInPlace(y[j]);
 	}
 	for (int k = 0; k < blocks; ++k) x[k] = y[inverse_[k]];

@@ -1,5 +1,7 @@
 #include "CoupledSystem.hpp"
 
+#include "BlockKernels.hpp"
+
 #include "dda/core/CapacityBytes.hpp"
 
 #include <Eigen/Cholesky>
@@ -298,11 +300,11 @@ bool CoupledSystem::refineComponent(int c, const BlockCholesky& factor, int maxI
 	// y = K x, K symmetric from the lower triangles of its diagonal blocks
 	// (the triangles the Cholesky reads) and the stored upper blocks.
 	auto multiply = [&](const std::vector<Vector12>& x, std::vector<Vector12>& y) {
-		for (int k = 0; k < n; ++k) y[k].noalias() = diagonal_[first + k].selfadjointView<Eigen::Lower>() * x[k];
+		for (int k = 0; k < n; ++k) symmetricLowerProduct(y[k], diagonal_[first + k], x[k]);
 		for (int l = linkFirst; l < linkLast; ++l) {
 			const int lo = linkSlots_[l].first - first, hi = linkSlots_[l].second - first;
-			y[lo].noalias() += offDiagonal_[l] * x[hi];
-			y[hi].noalias() += offDiagonal_[l].transpose() * x[lo];
+			addProduct(y[lo], offDiagonal_[l], x[hi]);
+			addTransposedProduct(y[hi], offDiagonal_[l], x[lo]);
 		}
 		restrictRigid(y);
 	};

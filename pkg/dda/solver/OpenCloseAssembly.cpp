@@ -4,6 +4,7 @@
 // alone), and the contacts' terms (kept while their state stays).
 #include "OpenClose.hpp"
 
+#include "BlockKernels.hpp"
 #include "StepClock.hpp"
 
 #include <algorithm>
@@ -132,15 +133,17 @@ void OpenCloseIteration::assembleContacts(const Attempt& attempt) {
 		// the stored off-diagonal one, (i, j), or (j, i) when transposed.
 		for (int r = 0; r < terms.rank; ++r) {
 			const Vector24 scaled = terms.weight[r] * terms.vector[r];
-			const auto vi = terms.vector[r].head<12>(), vj = terms.vector[r].tail<12>();
-			const auto si = scaled.head<12>(), sj = scaled.tail<12>();
-			if (diagonalI) diagonalI->noalias() += si * vi.transpose();
-			if (diagonalJ) diagonalJ->noalias() += sj * vj.transpose();
+			const double* vi = terms.vector[r].data();
+			const double* vj = vi + 12;
+			const double* si = scaled.data();
+			const double* sj = si + 12;
+			if (diagonalI) addOuterProduct(*diagonalI, si, vi);
+			if (diagonalJ) addOuterProduct(*diagonalJ, sj, vj);
 			if (offDiagonal) {
 				if (transposed)
-					offDiagonal->noalias() += sj * vi.transpose();
+					addOuterProduct(*offDiagonal, sj, vi);
 				else
-					offDiagonal->noalias() += si * vj.transpose();
+					addOuterProduct(*offDiagonal, si, vj);
 			}
 		}
 		if (diagonalI) coupled_.force(mi) += terms.force.head<12>();

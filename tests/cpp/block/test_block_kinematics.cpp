@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 using namespace dda;
@@ -23,6 +24,27 @@ TEST(BlockKinematics, DisplacementMatrixMatchesFieldAndEquation3) {
 		const double v = D(1) - d.z() * D(3) + d.x() * D(5) + d.y() * D(7) + d.x() * D(9) / 2 + d.z() * D(10) / 2;
 		const double w = D(2) + d.y() * D(3) - d.x() * D(4) + d.z() * D(8) + d.y() * D(10) / 2 + d.x() * D(11) / 2;
 		EXPECT_NEAR((displacementMatrix(d) * D - Vector3(u, v, w)).norm(), 0, 1e-14);
+	}
+}
+
+// The closed form of (s T(d))^T g equals Eigen's product of the matrices
+// entry by entry (the same products in the same order; == also takes -0 for
+// +0), and is the virtual work: g . T(d) D = ((1 T(d))^T g) . D for any D.
+TEST(BlockKinematics, DisplacementTransposeTimesIsTheMatrixProduct) {
+	const unsigned seed = 11;
+	std::printf("seed %u\n", seed);
+	std::mt19937 rng(seed);
+	std::uniform_real_distribution<double> scale(-3, 3);
+	for (int trial = 0; trial < 2000; ++trial) {
+		const Vector3 d = std::pow(10.0, scale(rng)) * randomUnknowns(rng).head<3>();
+		const Vector3 g = std::pow(10.0, scale(rng)) * randomUnknowns(rng).head<3>();
+		const double s = std::pow(10.0, scale(rng)) * (trial % 2 ? 1 : -1);
+		const Vector12 closed = displacementTransposeTimes(d, g, s);
+		const Vector12 eigen = (s * displacementMatrix(d).transpose()) * g;
+		for (int i = 0; i < 12; ++i) ASSERT_EQ(closed(i), eigen(i)) << "entry " << i << " trial " << trial;
+		const Vector12 D = randomUnknowns(rng);
+		EXPECT_NEAR(displacementTransposeTimes(d, g, 1.0).dot(D), g.dot(displacementMatrix(d) * D),
+		            1e-13 * g.norm() * (1 + d.norm()) * D.norm());
 	}
 }
 
