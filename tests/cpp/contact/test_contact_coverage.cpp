@@ -65,6 +65,63 @@ double signedDistance(const PartPlanes& p, const Vector3& x, int* nearest = null
 	return best;
 }
 
+// The largest separation [m] of two convex parts over every separating axis
+// (SAT): the face normals of both (Newell, planesOf) and the cross products of
+// each edge of one with each edge of the other, each axis measured as the gap
+// between the two corner sets' projections on it. Any unit axis gives at most
+// the parts' signed distance, and these contain the normal of the Minkowski
+// difference's face nearest the origin, so the maximum is minus the
+// penetration depth when the parts overlap (a lower bound of their distance
+// when apart). Computed here from the start-of-step corners, not by the
+// narrow phase. For the diagnosis of a gap deeper than that, edge pairs can
+// be left out as the narrow phase's depth bound leaves them out: those
+// parallel within `parallelSine` (sine of the angle), and with
+// `skipInternalEdges` those with an edge along an edge of a face shared with
+// another part (the narrow phase takes an edge pair's axis from the pair
+// whose Gauss-map arcs cross, which may be the internal one of several
+// parallel edges).
+double partSeparation(const Block& a, const std::vector<Vector3>& ca, const PartPlanes& pa, const Block& b,
+                      const std::vector<Vector3>& cb, const PartPlanes& pb, double parallelSine = 0,
+                      bool skipInternalEdges = false) {
+	const auto along = [&](const Vector3& n) {
+		double loA = std::numeric_limits<double>::infinity(), hiA = -loA, loB = loA, hiB = -loA;
+		for (const Vector3& x : ca) {
+			loA = std::min(loA, n.dot(x));
+			hiA = std::max(hiA, n.dot(x));
+		}
+		for (const Vector3& x : cb) {
+			loB = std::min(loB, n.dot(x));
+			hiB = std::max(hiB, n.dot(x));
+		}
+		return std::max(loB - hiA, loA - hiB);
+	};
+	const auto direction = [](const Block& block, const std::vector<Vector3>& c, int e) {
+		return Vector3(c[block.shape->edges[e][1]] - c[block.shape->edges[e][0]]);
+	};
+	const auto internalEdge = [&](const Block& block, const std::vector<Vector3>& c, const PartPlanes& p, int e) {
+		const Vector3 d = direction(block, c, e);
+		for (int k = 0; k < static_cast<int>(block.shape->edges.size()); ++k) {
+			const auto& faces = block.shape->edgeFaces[k];
+			if (!p.internal[faces[0]] && !p.internal[faces[1]]) continue;
+			const Vector3 dk = direction(block, c, k);
+			if (d.cross(dk).norm() <= 1e-9 * d.norm() * dk.norm()) return true;
+		}
+		return false;
+	};
+	double best = -std::numeric_limits<double>::infinity();
+	for (const PartPlanes* p : {&pa, &pb})
+		for (const Vector3& n : p->normals) best = std::max(best, along(n));
+	for (int ea = 0; ea < static_cast<int>(a.shape->edges.size()); ++ea)
+		for (int eb = 0; eb < static_cast<int>(b.shape->edges.size()); ++eb) {
+			if (skipInternalEdges && (internalEdge(a, ca, pa, ea) || internalEdge(b, cb, pb, eb))) continue;
+			const Vector3 da = direction(a, ca, ea), db = direction(b, cb, eb);
+			const Vector3 n = da.cross(db);
+			if (!(n.norm() > 0) || n.norm() <= parallelSine * da.norm() * db.norm()) continue;
+			best = std::max(best, along(n.normalized()));
+		}
+	return best;
+}
+
 double diagonal(const std::vector<Vector3>& corners) {
 	Eigen::AlignedBox3d box;
 	for (const Vector3& x : corners) box.extend(x);
@@ -91,10 +148,18 @@ struct Coverage {
 	std::string deepestNewWhere;
 	// Vertex-face contacts with a gap below -tolerance whose corner lies
 	// outside every part of the face's block by more than the tolerance: a
-	// gap that measures no overlap (a ghost).
-	long ghosts = 0;
+	// gap that measures no overlap (a ghost). Within the pair's penetration
+	// (gap >= -(depth + tolerance), depth from partSeparation): the narrow
+	// phase's depth bound allows it; deeper: it does not.
+	long ghosts = 0, ghostsWithinDepth = 0, ghostsBeyondDepth = 0;
+	// Of those deeper, by the axes that would allow them (diagnosis): within
+	// the depth without the edge pairs parallel within the angle tolerance;
+	// only without the edges of internal faces as well; neither.
+	long beyondNearParallel = 0, beyondInternalEdges = 0, beyondOther = 0;
 	double deepestGhost = 0;  // [m], its gap
 	std::string deepestGhostWhere;
+	double deepestBeyond = 0;  // [m], gap + depth of the worst beyond the depth
+	std::string deepestBeyondWhere;
 	std::map<std::string, long> uncoveredByType;  // pair's structural type of the uncovered corners
 	double d0 = 0;
 };
@@ -198,12 +263,34 @@ Coverage measure(World& world, int steps, double tolerance) {
 					outside = std::min(outside, signedDistance(planes[m], x));
 			if (!(outside > tolerance)) continue;
 			++result.ghosts;
+			const int i = c.key.blockI, j = c.key.blockJ;
+			const double depth =
+			    std::max(0.0, -partSeparation(world.block(i), corners[i], planes[i], world.block(j), corners[j], planes[j]));
+			const bool beyond = c.geometry.gap < -(depth + tolerance);
+			++(beyond ? result.ghostsBeyondDepth : result.ghostsWithinDepth);
+			if (beyond) {
+				const double minDiagonal = std::min(diagonal(corners[i]), diagonal(corners[j]));
+				const double angle = std::clamp(2 * stats.allowedDisplacement / minDiagonal, 1e-6, 0.05);
+				const double parallelSine = std::sin(angle);
+				const auto depthWithout = [&](double sine, bool internalEdges) {
+					return std::max(0.0, -partSeparation(world.block(i), corners[i], planes[i], world.block(j),
+					                                     corners[j], planes[j], sine, internalEdges));
+				};
+				if (!(c.geometry.gap < -(depthWithout(parallelSine, false) + tolerance))) ++result.beyondNearParallel;
+				else if (!(c.geometry.gap < -(depthWithout(parallelSine, true) + tolerance))) ++result.beyondInternalEdges;
+				else ++result.beyondOther;
+			}
+			char where[240];
+			std::snprintf(where, sizeof where,
+			              "step %d: corner %d of part %d on face %d of part %d, %.3g m outside, pair depth %.3g m, type %s",
+			              step, c.key.feature1, i, c.key.feature2, j, outside, depth, contactTypeName(c.pairType));
 			if (-c.geometry.gap > result.deepestGhost) {
 				result.deepestGhost = -c.geometry.gap;
-				char where[200];
-				std::snprintf(where, sizeof where, "step %d: corner %d of part %d on face %d of part %d, %.3g m outside",
-				              step, c.key.feature1, c.key.blockI, c.key.feature2, c.key.blockJ, outside);
 				result.deepestGhostWhere = where;
+			}
+			if (beyond && -(c.geometry.gap + depth) > result.deepestBeyond) {
+				result.deepestBeyond = -(c.geometry.gap + depth);
+				result.deepestBeyondWhere = where;
 			}
 		}
 		for (const Contact& c : world.contacts()) {
@@ -242,8 +329,12 @@ void print(const char* name, unsigned seed, const Coverage& c) {
 	            name, seed, c.d0, c.insideCorners, c.uncovered, c.uncoveredPairless, c.uncoveredOtherSide,
 	            c.uncoveredAtInternal, c.merged, c.deepestUncovered, c.deepestWhere.c_str(), c.newContacts, c.newDeep,
 	            c.deepestNew, c.deepestNewRatio, c.deepestNewWhere.c_str());
-	std::printf("  %ld vertex contacts with a negative gap for a corner outside the face's block, deepest gap %.3g m [%s]\n",
-	            c.ghosts, -c.deepestGhost, c.deepestGhostWhere.c_str());
+	std::printf("  %ld vertex contacts with a negative gap for a corner outside the face's block, deepest gap %.3g m [%s]\n"
+	            "    (a) %ld within the pair's penetration depth, (b) %ld deeper, by up to %.3g m [%s]\n"
+	            "    (b) allowed only without the near-parallel edge axes %ld, only without the axes along internal edges too %ld, "
+	            "neither %ld\n",
+	            c.ghosts, -c.deepestGhost, c.deepestGhostWhere.c_str(), c.ghostsWithinDepth, c.ghostsBeyondDepth,
+	            c.deepestBeyond, c.deepestBeyondWhere.c_str(), c.beyondNearParallel, c.beyondInternalEdges, c.beyondOther);
 	for (const auto& [type, count] : c.uncoveredByType) std::printf("  uncovered in pairs of type %s: %ld\n", type.c_str(), count);
 }
 
