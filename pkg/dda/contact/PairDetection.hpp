@@ -162,8 +162,9 @@ struct BlockGeometry {
 	Vector3 centroid = Vector3::Zero();            // [m]
 	// Optional, per face: 1 for a face fully covered by a coplanar, opposed
 	// face of a neighbouring fixed block (a flush joint). Such a face is not
-	// a free surface: it still rejects pairs whose separation it proves, but
-	// is never an entrance face, and its edges give no edge axes. Without
+	// a free surface: it still rejects pairs whose separation it proves and
+	// bounds their penetration, but is never an entrance face, and the axes
+	// of its edges reject and bound as well but are no entrance. Without
 	// this, a block sliding across the joint meets the covered side face as a
 	// "ghost" obstacle.
 	const std::vector<char>* internalFaces = nullptr;

@@ -1091,6 +1091,60 @@ TEST(ContactDetection, GhostPairsOfTheDepositHaveNoNegativeGap) {
 	}
 }
 
+// A part of a concave block (the unit cube, its face x = 1 shared with the
+// next part: internal) and a box crossing the part's ridge, the edge (x, z) =
+// (1, 1) along y that the top face shares with the internal face: the box's
+// lowest edge, 0.2 m long, runs along (1, 0, -1), h above the ridge along
+// (1, 0, 1) / sqrt(2), slightly turned (a generic placement). Closed form:
+// the two are h apart, separated only along the cross product of the two
+// edges (every face axis shows an overlap: the box's edge dips below the top
+// face's plane beyond the seam). No sub-contact may then have a negative gap,
+// and beyond d0 the pair has no contact. The ridge's axis was left out when
+// its edge lay on an internal face: the pair seemed to overlap by 7 cm (a
+// face axis), and the box's lower corner beyond the seam, below the top
+// face's plane but outside the part, took a gap of -7 cm 0.5 mm apart (as
+// in the roofs of tests/cpp/contact/test_contact_coverage.cpp: -9.2 cm, 3.2
+// cm outside).
+TEST(ContactDetection, InternalEdgesBoundThePenetrationOfAPartAcrossItsRidge) {
+	const Block part = box(Vector3(0, 0, 0), Vector3(1, 1, 1));
+	std::vector<char> internal(part.shape.faces.size(), 0);
+	for (std::size_t f = 0; f < part.shape.faces.size(); ++f)
+		internal[f] = dda::faceNormal(part.vertices, part.shape.faces[f]).x() > 0.5;
+	ASSERT_EQ(std::count(internal.begin(), internal.end(), 1), 1);
+	const Vector3 along = Vector3(1, 0, -1).normalized(), out = Vector3(1, 0, 1).normalized();
+	const Vector3 u = (out + Vector3::UnitY()).normalized(), v = (out - Vector3::UnitY()).normalized();
+	const double d0 = 0.1;
+	const DetectionSettings s = settings(d0);
+	for (const double h : {0.0005, 0.02, 0.08, 0.15}) {
+		SCOPED_TRACE("h = " + std::to_string(h));
+		std::vector<Vector3> corners;
+		const Vector3 edge = Vector3(1, 0.5, 1) + h * out;
+		for (const double t : {-0.1, 0.1})
+			for (const double a : {0.0, 0.5})
+				for (const double b : {0.0, 0.5}) corners.push_back(edge + t * along + a * u + b * v);
+		// Turned by 0.01 rad about the common normal through the edges' crossing.
+		const Block crossing = moved(makeBlock(corners), rotationAbout(out, 0.01),
+		                             edge - rotationAbout(out, 0.01) * edge);
+		const double apart = bruteForceSeparation(part, crossing);
+		ASSERT_NEAR(apart, h, 1e-12);
+		for (const bool swap : {false, true}) {
+			SCOPED_TRACE(swap ? "swapped" : "part first");
+			const dda::BlockGeometry gp{&part.shape, &part.vertices, part.centroid, &internal};
+			const dda::BlockGeometry gc = crossing.geometry();
+			const auto result = swap ? dda::detectPairContacts(gc, gp, s) : dda::detectPairContacts(gp, gc, s);
+			if (h > d0) {
+				EXPECT_FALSE(result.has_value()) << describe(*result);
+				continue;
+			}
+			ASSERT_TRUE(result.has_value());
+			SCOPED_TRACE(describe(*result));
+			EXPECT_FALSE(result->contacts.empty());
+			for (const SubContact& c : result->contacts)
+				EXPECT_GE(c.gap, -kLengthTolerance) << "a sub-contact between blocks " << apart << " m apart";
+		}
+	}
+}
+
 // Three pairs the narrow-phase oracle found in its 2,000,000-pair run (seed
 // 20250917, pairs 415996, 666220 and 1160967 of
 // tests/cpp/contact/test_narrow_phase_oracle.cpp), with World's settings for d0 = 1 cm:
