@@ -34,7 +34,12 @@
 //        - vertex-face F <- P for each corner P of I within d0 of F's plane
 //          whose projection lies within d0 of F (a corner just past F's
 //          edge or corner is a vertex-edge or vertex-vertex contact, entered
-//          through F);
+//          through F); but a corner below F's plane that lies outside R,
+//          past an exposed face of R and past an edge of F along which none
+//          of its own edges runs (within the angle tolerance), is measured
+//          against its own entrance face of R instead, as the corners Q
+//          below are: its gap is then positive (outsideBeyondFaceEdge,
+//          SubContacts.cpp: no overlap at a corner outside R to push on);
 //        - vertex-face G <- Q for each corner Q of F within d0 of I, G the
 //          face of I of largest signed distance of Q (Q's own entrance face),
 //          Q's projection within d0 of G, and Q not within
