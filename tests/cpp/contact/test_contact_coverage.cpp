@@ -180,6 +180,14 @@ struct Coverage {
 	// add to the springs between steps), its steps' increases and decreases
 	// summed apart [J].
 	double contactChanges = 0, contactGains = 0, contactLosses = 0;
+	// Pairs of parts that overlap (their separating axes, partSeparation, by
+	// more than the tolerance) while none of their sub-contacts has a
+	// negative gap: an overlap with no spring to push it apart.
+	long overlapsUnpushed = 0;
+	double deepestUnpushed = 0;  // [m]
+	std::string deepestUnpushedWhere;
+	double largestGain = 0;  // [J], of one step
+	int largestGainStep = -1;
 	double d0 = 0;
 };
 
@@ -215,6 +223,10 @@ Coverage measure(World& world, int steps, double tolerance) {
 		{
 			const double change = world.energy().contactChanges - changesBefore;
 			(change > 0 ? result.contactGains : result.contactLosses) += change;
+			if (change > result.largestGain) {
+				result.largestGain = change;
+				result.largestGainStep = step;
+			}
 			result.contactChanges = world.energy().contactChanges;
 		}
 		result.d0 = stats.contactDistance;
@@ -277,6 +289,32 @@ Coverage measure(World& world, int steps, double tolerance) {
 						              type == pairType.end() ? "none" : type->second.c_str());
 						result.deepestWhere = where;
 					}
+				}
+			}
+		std::map<std::pair<int, int>, double> pairLowest;  // (smaller, larger part): lowest gap of its contacts
+		for (const Contact& c : world.contacts()) {
+			const std::pair<int, int> key{std::min(c.key.blockI, c.key.blockJ), std::max(c.key.blockI, c.key.blockJ)};
+			const auto it = pairLowest.find(key);
+			pairLowest[key] = it == pairLowest.end() ? c.geometry.gap : std::min(it->second, c.geometry.gap);
+		}
+		for (int p = 0; p < n; ++p)
+			for (int q = p + 1; q < n; ++q) {
+				if (bodyOf(world, p) == bodyOf(world, q) || (world.block(p).fixed && world.block(q).fixed)) continue;
+				Eigen::AlignedBox3d boxP, boxQ;
+				for (const Vector3& x : corners[p]) boxP.extend(x);
+				for (const Vector3& x : corners[q]) boxQ.extend(x);
+				if (!boxP.intersects(boxQ)) continue;
+				const double sep = partSeparation(world.block(p), corners[p], planes[p], world.block(q), corners[q], planes[q]);
+				if (!(sep < -tolerance)) continue;
+				const auto lowest = pairLowest.find({p, q});
+				if (lowest != pairLowest.end() && lowest->second < 0) continue;
+				++result.overlapsUnpushed;
+				if (-sep > result.deepestUnpushed) {
+					result.deepestUnpushed = -sep;
+					char where[160];
+					std::snprintf(where, sizeof where, "step %d: parts %d and %d, lowest gap of their contacts %.3g m", step, p, q,
+					              lowest == pairLowest.end() ? std::numeric_limits<double>::infinity() : lowest->second);
+					result.deepestUnpushedWhere = where;
 				}
 			}
 		for (const Contact& c : world.contacts()) {
@@ -384,8 +422,11 @@ void print(const char* name, unsigned seed, const Coverage& c) {
 	            c.ghosts, -c.deepestGhost, c.deepestGhostWhere.c_str(), c.ghostsWithinDepth, c.ghostsBeyondDepth,
 	            c.deepestBeyond, c.deepestBeyondWhere.c_str(), c.beyondNearParallel, c.beyondInternalEdges,
 	            c.beyondOther, c.ghostsAlongEdge, c.ghostsAcrossEdge, -c.deepestAcross, c.deepestAcrossWhere.c_str());
-	std::printf("  energy account: contactChanges %.4g J (steps' gains %.4g J, losses %.4g J)\n", c.contactChanges,
-	            c.contactGains, c.contactLosses);
+	std::printf("  %ld pair instances overlapping with no negative gap among their contacts, deepest %.3g m [%s]\n",
+	            c.overlapsUnpushed, c.deepestUnpushed, c.deepestUnpushedWhere.c_str());
+	std::printf("  energy account: contactChanges %.4g J (steps' gains %.4g J, losses %.4g J; largest gain %.4g J at "
+	            "step %d)\n",
+	            c.contactChanges, c.contactGains, c.contactLosses, c.largestGain, c.largestGainStep);
 	for (const auto& [type, count] : c.uncoveredByType) std::printf("  uncovered in pairs of type %s: %ld\n", type.c_str(), count);
 }
 
