@@ -34,7 +34,12 @@
 //        - vertex-face F <- P for each corner P of I within d0 of F's plane
 //          whose projection lies within d0 of F (a corner just past F's
 //          edge or corner is a vertex-edge or vertex-vertex contact, entered
-//          through F);
+//          through F); but a corner below F's plane that lies outside R,
+//          past an exposed face of R and past an edge of F along which none
+//          of its own edges runs (within the angle tolerance), is measured
+//          against its own entrance face of R instead, as the corners Q
+//          below are: its gap is then positive (outsideBeyondFaceEdge,
+//          SubContacts.cpp: no overlap at a corner outside R to push on);
 //        - vertex-face G <- Q for each corner Q of F within d0 of I, G the
 //          face of I of largest signed distance of Q (Q's own entrance face),
 //          Q's projection within d0 of G, and Q not within
@@ -162,8 +167,9 @@ struct BlockGeometry {
 	Vector3 centroid = Vector3::Zero();            // [m]
 	// Optional, per face: 1 for a face fully covered by a coplanar, opposed
 	// face of a neighbouring fixed block (a flush joint). Such a face is not
-	// a free surface: it still rejects pairs whose separation it proves, but
-	// is never an entrance face, and its edges give no edge axes. Without
+	// a free surface: it still rejects pairs whose separation it proves and
+	// bounds their penetration, but is never an entrance face, and the axes
+	// of its edges reject and bound as well but are no entrance. Without
 	// this, a block sliding across the joint meets the covered side face as a
 	// "ghost" obstacle.
 	const std::vector<char>* internalFaces = nullptr;

@@ -46,6 +46,7 @@ struct Scratch {
 	std::vector<double> cornerDistances;
 	std::vector<char> cornerDistanceReady;
 	std::vector<int> used, faceEdges;
+	std::vector<int> outsideCorners;  // faceEntranceContacts: corners measured against their own face
 	std::vector<int> edgeFacesB, arcSides;  // the edge axes' Gauss-map test
 	std::vector<Vector3> inwardNormalsB;     // minus the normals of edgeFacesB, in its order
 	std::vector<std::array<int, 3>> edgesB;  // B's edges for edge axes: edge, its two faces

@@ -221,6 +221,26 @@ bool searchFaceAxes(const Prepared& a, const Prepared& b, double d0, double hyst
 // that cross are listed in order (their positions in s.edgesB), written
 // and kept by the test's value rather than by a branch, and their axes
 // computed in the same order as before.
+//
+// Edges of internal faces (a face shared with another part of a concave
+// block, or covered by a flush fixed neighbour) give axes as every edge does,
+// but no entrance: like an internal face, such an axis rejects the pair and
+// bounds its penetration (axes.deepestBound), and is never bestEdge. The
+// two blocks of a pair are convex whatever their neighbours, and the axis of
+// an edge pair whose arcs cross is a face of their Minkowski difference: left
+// out, the largest separation can miss the one that separates them, and the
+// depth bound of step 3 then lets through sub-contacts as deep as a wrong
+// axis says the blocks overlap. A roof's part lying across another roof's
+// ridge (tests/cpp/contact/test_contact_coverage.cpp, roofs at E = 1e8 Pa,
+// seed 3) was 1.8 cm from the part it met along the axis of that ridge (an
+// edge of the seam face) and another part's corner, 3.2 cm outside the
+// whole roof, took a gap of -9.2 cm on a face whose plane runs on past the
+// ridge: 20 such corner contacts in the oracle's roofs and concave piles
+// (seeds 3 and 17), none after (and the closed form of
+// InternalEdgesBoundThePenetrationOfAPartAcrossItsRidge). The axis only removes what no overlap measures: a rejected pair
+// has no contact, and a sub-contact below minus the true penetration would
+// still have a negative gap after a translation that separates the blocks.
+// Removing a contact leaves no spring, so it creates no energy.
 bool searchEdgeAxes(const Prepared& a, const Prepared& b, double d0, double sinTolerance,
                     const EntranceFeature& previous, Scratch& s, AxisSearch& axes) {
 	// The faces of B at its usable edges (their planes are built:
@@ -236,7 +256,6 @@ bool searchEdgeAxes(const Prepared& a, const Prepared& b, double d0, double sinT
 	inward.clear();
 	bEdges.clear();
 	for (int eb : b.edgeList) {
-		if (b.internalEdge(eb)) continue;
 		const auto& fb = b.shape->edgeFaces[eb];
 		bEdges.push_back({eb, fb[0], fb[1]});
 		for (int g : fb) {
@@ -258,7 +277,6 @@ bool searchEdgeAxes(const Prepared& a, const Prepared& b, double d0, double sinT
 	faceRow.assign(a.faceCount(), -1);
 	int rows = 0;
 	for (int ea : a.edgeList) {
-		if (a.internalEdge(ea)) continue;
 		for (int f : a.shape->edgeFaces[ea])
 			if (faceRow[f] < 0) faceRow[f] = rows++;
 	}
@@ -278,7 +296,7 @@ bool searchEdgeAxes(const Prepared& a, const Prepared& b, double d0, double sinT
 		}
 	}
 	for (int ea : a.edgeList) {
-		if (a.internalEdge(ea)) continue;
+		const bool internalA = a.internalEdge(ea);
 		const auto& fa = a.shape->edgeFaces[ea];
 		const Vector3& faceA0 = a.faces[fa[0]].normal;  // A
 		const Vector3& faceA1 = a.faces[fa[1]].normal;  // B
@@ -308,6 +326,7 @@ bool searchEdgeAxes(const Prepared& a, const Prepared& b, double d0, double sinT
 				return false;
 			}
 			axes.deepestBound = std::max(axes.deepestBound, axis.separation);
+			if (internalA || b.internalEdge(eb)) continue;  // no entrance
 			if (previous.kind == EntranceFeature::EdgePair && previous.feature == ea && previous.other == eb)
 				axes.previousEdge = axis;
 			if (!axes.bestEdge.valid || axis.separation > axes.bestEdge.separation) {

@@ -25,7 +25,8 @@ struct EdgeAxis {
 
 // What step 1 found besides the face candidates.
 struct AxisSearch {
-	// Largest separation over every axis tested, internal faces included: minus
+	// Largest separation over every axis tested, internal faces and the edges
+	// of internal faces included: minus
 	// the pair's penetration depth, or less [m].
 	double deepestBound = -std::numeric_limits<double>::infinity();
 	// Largest separation of an entrance-eligible (non-internal) face [m].

@@ -7,6 +7,14 @@
 // printed), as concave blocks and, for comparison, with every part a convex
 // block of its own.
 //
+// Ghosts: a vertex-face contact with a negative gap whose corner lies outside
+// the face's block pushes where nothing overlaps at the corner. Each is
+// measured against the pair's own penetration depth, the separating axes of
+// the two convex parts computed here (partSeparation), and asserted to be the
+// one kind the narrow phase means to give: a corner whose edge runs along the
+// edge of the face it lies past (near-parallel edges, whose contact is the
+// vertex contacts at their ends measured along the entrance face).
+//
 // Why it is physics: a penalty contact pushes only where a contact exists; a
 // corner inside the other block with no contact of its own meets no force
 // until some later detection finds it, already deep, and a new contact has no
@@ -65,6 +73,63 @@ double signedDistance(const PartPlanes& p, const Vector3& x, int* nearest = null
 	return best;
 }
 
+// The largest separation [m] of two convex parts over every separating axis
+// (SAT): the face normals of both (Newell, planesOf) and the cross products of
+// each edge of one with each edge of the other, each axis measured as the gap
+// between the two corner sets' projections on it. Any unit axis gives at most
+// the parts' signed distance, and these contain the normal of the Minkowski
+// difference's face nearest the origin, so the maximum is minus the
+// penetration depth when the parts overlap (a lower bound of their distance
+// when apart). Computed here from the start-of-step corners, not by the
+// narrow phase. For the diagnosis of a gap deeper than that, edge pairs can
+// be left out as the narrow phase's depth bound leaves them out: those
+// parallel within `parallelSine` (sine of the angle), and with
+// `skipInternalEdges` those with an edge along an edge of a face shared with
+// another part (the narrow phase takes an edge pair's axis from the pair
+// whose Gauss-map arcs cross, which may be the internal one of several
+// parallel edges).
+double partSeparation(const Block& a, const std::vector<Vector3>& ca, const PartPlanes& pa, const Block& b,
+                      const std::vector<Vector3>& cb, const PartPlanes& pb, double parallelSine = 0,
+                      bool skipInternalEdges = false) {
+	const auto along = [&](const Vector3& n) {
+		double loA = std::numeric_limits<double>::infinity(), hiA = -loA, loB = loA, hiB = -loA;
+		for (const Vector3& x : ca) {
+			loA = std::min(loA, n.dot(x));
+			hiA = std::max(hiA, n.dot(x));
+		}
+		for (const Vector3& x : cb) {
+			loB = std::min(loB, n.dot(x));
+			hiB = std::max(hiB, n.dot(x));
+		}
+		return std::max(loB - hiA, loA - hiB);
+	};
+	const auto direction = [](const Block& block, const std::vector<Vector3>& c, int e) {
+		return Vector3(c[block.shape->edges[e][1]] - c[block.shape->edges[e][0]]);
+	};
+	const auto internalEdge = [&](const Block& block, const std::vector<Vector3>& c, const PartPlanes& p, int e) {
+		const Vector3 d = direction(block, c, e);
+		for (int k = 0; k < static_cast<int>(block.shape->edges.size()); ++k) {
+			const auto& faces = block.shape->edgeFaces[k];
+			if (!p.internal[faces[0]] && !p.internal[faces[1]]) continue;
+			const Vector3 dk = direction(block, c, k);
+			if (d.cross(dk).norm() <= 1e-9 * d.norm() * dk.norm()) return true;
+		}
+		return false;
+	};
+	double best = -std::numeric_limits<double>::infinity();
+	for (const PartPlanes* p : {&pa, &pb})
+		for (const Vector3& n : p->normals) best = std::max(best, along(n));
+	for (int ea = 0; ea < static_cast<int>(a.shape->edges.size()); ++ea)
+		for (int eb = 0; eb < static_cast<int>(b.shape->edges.size()); ++eb) {
+			if (skipInternalEdges && (internalEdge(a, ca, pa, ea) || internalEdge(b, cb, pb, eb))) continue;
+			const Vector3 da = direction(a, ca, ea), db = direction(b, cb, eb);
+			const Vector3 n = da.cross(db);
+			if (!(n.norm() > 0) || n.norm() <= parallelSine * da.norm() * db.norm()) continue;
+			best = std::max(best, along(n.normalized()));
+		}
+	return best;
+}
+
 double diagonal(const std::vector<Vector3>& corners) {
 	Eigen::AlignedBox3d box;
 	for (const Vector3& x : corners) box.extend(x);
@@ -91,11 +156,38 @@ struct Coverage {
 	std::string deepestNewWhere;
 	// Vertex-face contacts with a gap below -tolerance whose corner lies
 	// outside every part of the face's block by more than the tolerance: a
-	// gap that measures no overlap (a ghost).
-	long ghosts = 0;
+	// gap that measures no overlap at the corner (a ghost). (a) within the
+	// pair's penetration depth (gap >= -(depth + tolerance), depth from
+	// partSeparation over every axis), (b) deeper; (b) by the axes whose
+	// omission allows it: (b1) within the depth without the edge pairs
+	// parallel within the angle tolerance (which the narrow phase lets bound
+	// crossings, not corners: PairDetection.hpp), (b2) only without the axes
+	// along internal faces' edges too, (b3) neither.
+	long ghosts = 0, ghostsWithinDepth = 0, ghostsBeyondDepth = 0;
+	long beyondNearParallel = 0, beyondInternalEdges = 0, beyondOther = 0;
 	double deepestGhost = 0;  // [m], its gap
 	std::string deepestGhostWhere;
+	double deepestBeyond = 0;  // [m], gap + depth of the worst beyond the depth
+	std::string deepestBeyondWhere;
+	// Ghosts that stand for a near-parallel edge contact: the corner lies
+	// beyond an edge of the face along which an edge of the corner's block
+	// runs within the angle tolerance; and the others, the deepest of them.
+	long ghostsAlongEdge = 0, ghostsAcrossEdge = 0;
+	double deepestAcross = 0;  // [m], its gap
+	std::string deepestAcrossWhere;
 	std::map<std::string, long> uncoveredByType;  // pair's structural type of the uncovered corners
+	// The energy account's contactChanges (what contact detection and states
+	// add to the springs between steps), its steps' increases and decreases
+	// summed apart [J].
+	double contactChanges = 0, contactGains = 0, contactLosses = 0;
+	// Pairs of parts that overlap (their separating axes, partSeparation, by
+	// more than the tolerance) while none of their sub-contacts has a
+	// negative gap: an overlap with no spring to push it apart.
+	long overlapsUnpushed = 0;
+	double deepestUnpushed = 0;  // [m]
+	std::string deepestUnpushedWhere;
+	double largestGain = 0;  // [J], of one step
+	int largestGainStep = -1;
 	double d0 = 0;
 };
 
@@ -125,8 +217,18 @@ Coverage measure(World& world, int steps, double tolerance) {
 						    planes[i].normals[f].dot(planes[j].normals[g]) < -0.999)
 							planes[i].internal[f] = 1;
 			}
+		const double changesBefore = world.energy().contactChanges;
 		world.step(settings);
 		const StepStatistics& stats = world.lastStep();
+		{
+			const double change = world.energy().contactChanges - changesBefore;
+			(change > 0 ? result.contactGains : result.contactLosses) += change;
+			if (change > result.largestGain) {
+				result.largestGain = change;
+				result.largestGainStep = step;
+			}
+			result.contactChanges = world.energy().contactChanges;
+		}
 		result.d0 = stats.contactDistance;
 		// Corners with a contact: (part, vertex, other body); parts with a contact.
 		std::set<std::tuple<int, int, int>> vertexCovered;
@@ -189,6 +291,32 @@ Coverage measure(World& world, int steps, double tolerance) {
 					}
 				}
 			}
+		std::map<std::pair<int, int>, double> pairLowest;  // (smaller, larger part): lowest gap of its contacts
+		for (const Contact& c : world.contacts()) {
+			const std::pair<int, int> key{std::min(c.key.blockI, c.key.blockJ), std::max(c.key.blockI, c.key.blockJ)};
+			const auto it = pairLowest.find(key);
+			pairLowest[key] = it == pairLowest.end() ? c.geometry.gap : std::min(it->second, c.geometry.gap);
+		}
+		for (int p = 0; p < n; ++p)
+			for (int q = p + 1; q < n; ++q) {
+				if (bodyOf(world, p) == bodyOf(world, q) || (world.block(p).fixed && world.block(q).fixed)) continue;
+				Eigen::AlignedBox3d boxP, boxQ;
+				for (const Vector3& x : corners[p]) boxP.extend(x);
+				for (const Vector3& x : corners[q]) boxQ.extend(x);
+				if (!boxP.intersects(boxQ)) continue;
+				const double sep = partSeparation(world.block(p), corners[p], planes[p], world.block(q), corners[q], planes[q]);
+				if (!(sep < -tolerance)) continue;
+				const auto lowest = pairLowest.find({p, q});
+				if (lowest != pairLowest.end() && lowest->second < 0) continue;
+				++result.overlapsUnpushed;
+				if (-sep > result.deepestUnpushed) {
+					result.deepestUnpushed = -sep;
+					char where[160];
+					std::snprintf(where, sizeof where, "step %d: parts %d and %d, lowest gap of their contacts %.3g m", step, p, q,
+					              lowest == pairLowest.end() ? std::numeric_limits<double>::infinity() : lowest->second);
+					result.deepestUnpushedWhere = where;
+				}
+			}
 		for (const Contact& c : world.contacts()) {
 			if (c.key.kind != ContactKind::VertexFace || !(c.geometry.gap < -tolerance)) continue;
 			const Vector3& x = corners[c.key.blockI][c.key.feature1];
@@ -198,12 +326,56 @@ Coverage measure(World& world, int steps, double tolerance) {
 					outside = std::min(outside, signedDistance(planes[m], x));
 			if (!(outside > tolerance)) continue;
 			++result.ghosts;
+			const int i = c.key.blockI, j = c.key.blockJ;
+			const double depth =
+			    std::max(0.0, -partSeparation(world.block(i), corners[i], planes[i], world.block(j), corners[j], planes[j]));
+			const bool beyond = c.geometry.gap < -(depth + tolerance);
+			++(beyond ? result.ghostsBeyondDepth : result.ghostsWithinDepth);
+			// The narrow phase's angle tolerance (pairDetectionSettings): the turn
+			// of a block in a step at the allowed displacement, within [1e-6, 0.05] rad.
+			const double minDiagonal = std::min(diagonal(corners[i]), diagonal(corners[j]));
+			const double parallelSine = std::sin(std::clamp(2 * stats.allowedDisplacement / minDiagonal, 1e-6, 0.05));
+			if (beyond) {
+				const auto depthWithout = [&](double sine, bool internalEdges) {
+					return std::max(0.0, -partSeparation(world.block(i), corners[i], planes[i], world.block(j),
+					                                     corners[j], planes[j], sine, internalEdges));
+				};
+				if (!(c.geometry.gap < -(depthWithout(parallelSine, false) + tolerance))) ++result.beyondNearParallel;
+				else if (!(c.geometry.gap < -(depthWithout(parallelSine, true) + tolerance))) ++result.beyondInternalEdges;
+				else ++result.beyondOther;
+			}
+			const std::vector<int>& face = world.block(j).shape->faces[c.key.feature2];
+			const Vector3& normal = planes[j].normals[c.key.feature2];
+			bool alongEdge = false;
+			double past = 0;  // how far the corner's projection lies beyond the face's edges [m]
+			for (std::size_t k = 0; k < face.size(); ++k) {
+				const Vector3& start = corners[j][face[k]];
+				const Vector3 edge = corners[j][face[(k + 1) % face.size()]] - start;
+				const double margin = normal.cross(edge).normalized().dot(x - start);
+				if (!(margin < 0)) continue;
+				past = std::max(past, -margin);
+				for (const auto& e : world.block(i).shape->edges) {
+					if (e[0] != c.key.feature1 && e[1] != c.key.feature1) continue;
+					const Vector3 d = corners[i][e[1]] - corners[i][e[0]];
+					if (d.cross(edge).norm() <= parallelSine * d.norm() * edge.norm()) alongEdge = true;
+				}
+			}
+			++(alongEdge ? result.ghostsAlongEdge : result.ghostsAcrossEdge);
+			char where[240];
+			std::snprintf(where, sizeof where,
+			              "step %d: corner %d of part %d on face %d of part %d, %.3g m outside, pair depth %.3g m, type %s",
+			              step, c.key.feature1, i, c.key.feature2, j, outside, depth, contactTypeName(c.pairType));
 			if (-c.geometry.gap > result.deepestGhost) {
 				result.deepestGhost = -c.geometry.gap;
-				char where[200];
-				std::snprintf(where, sizeof where, "step %d: corner %d of part %d on face %d of part %d, %.3g m outside",
-				              step, c.key.feature1, c.key.blockI, c.key.feature2, c.key.blockJ, outside);
 				result.deepestGhostWhere = where;
+			}
+			if (beyond && -(c.geometry.gap + depth) > result.deepestBeyond) {
+				result.deepestBeyond = -(c.geometry.gap + depth);
+				result.deepestBeyondWhere = where;
+			}
+			if (!alongEdge && -c.geometry.gap > result.deepestAcross) {
+				result.deepestAcross = -c.geometry.gap;
+				result.deepestAcrossWhere = std::string(where) + ", " + std::to_string(past) + " m past the face";
 			}
 		}
 		for (const Contact& c : world.contacts()) {
@@ -242,8 +414,19 @@ void print(const char* name, unsigned seed, const Coverage& c) {
 	            name, seed, c.d0, c.insideCorners, c.uncovered, c.uncoveredPairless, c.uncoveredOtherSide,
 	            c.uncoveredAtInternal, c.merged, c.deepestUncovered, c.deepestWhere.c_str(), c.newContacts, c.newDeep,
 	            c.deepestNew, c.deepestNewRatio, c.deepestNewWhere.c_str());
-	std::printf("  %ld vertex contacts with a negative gap for a corner outside the face's block, deepest gap %.3g m [%s]\n",
-	            c.ghosts, -c.deepestGhost, c.deepestGhostWhere.c_str());
+	std::printf("  %ld vertex contacts with a negative gap for a corner outside the face's block, deepest gap %.3g m [%s]\n"
+	            "    (a) %ld within the pair's penetration depth, (b) %ld deeper, by up to %.3g m [%s]\n"
+	            "    (b) allowed only without the near-parallel edge axes %ld, only without the axes along internal "
+	            "edges too %ld, neither %ld\n"
+	            "    %ld with an edge along the face's edge they lie past, %ld not, deepest %.3g m [%s]\n",
+	            c.ghosts, -c.deepestGhost, c.deepestGhostWhere.c_str(), c.ghostsWithinDepth, c.ghostsBeyondDepth,
+	            c.deepestBeyond, c.deepestBeyondWhere.c_str(), c.beyondNearParallel, c.beyondInternalEdges,
+	            c.beyondOther, c.ghostsAlongEdge, c.ghostsAcrossEdge, -c.deepestAcross, c.deepestAcrossWhere.c_str());
+	std::printf("  %ld pair instances overlapping with no negative gap among their contacts, deepest %.3g m [%s]\n",
+	            c.overlapsUnpushed, c.deepestUnpushed, c.deepestUnpushedWhere.c_str());
+	std::printf("  energy account: contactChanges %.4g J (steps' gains %.4g J, losses %.4g J; largest gain %.4g J at "
+	            "step %d)\n",
+	            c.contactChanges, c.contactGains, c.contactLosses, c.largestGain, c.largestGainStep);
 	for (const auto& [type, count] : c.uncoveredByType) std::printf("  uncovered in pairs of type %s: %ld\n", type.c_str(), count);
 }
 
@@ -265,10 +448,18 @@ TEST(ContactCoverage, CornersInsideAnotherBlockHaveContacts) {
 				print(name, seed, c);
 				EXPECT_EQ(c.uncovered, 0) << name << " seed " << seed << ": " << c.deepestWhere;
 				EXPECT_EQ(c.newDeep, 0) << name << " seed " << seed << ": " << c.deepestNewWhere;
-				// Reported, not asserted: the narrow phase allows a corner outside
-				// the other block a gap down to minus the pair's penetration
-				// (SubContacts.cpp), which this count does not know; the roofs'
-				// deepest (-0.09 m, seed 3, E 1e8) is open.
+				// Ghosts: none deeper than the pair's penetration but as edge pairs
+				// parallel within the angle tolerance allow (b1), and every one a
+				// corner whose edge runs along the edge of the face it lies past
+				// (it stands for the near-parallel edges' contact, which has no
+				// crossing; outsideBeyondFaceEdge, SubContacts.cpp). Before: the
+				// roofs' -9.2 cm gap 3.2 cm outside (seed 3, E 1e8) and 19 more
+				// deeper than the overlap through the axes of internal faces'
+				// edges (b2), and 4 corners past a face's edge at a real angle
+				// (down to -1.2 mm, 3.3 cm outside).
+				EXPECT_EQ(c.beyondInternalEdges + c.beyondOther, 0) << name << " seed " << seed << ": "
+				                                                    << c.deepestBeyondWhere;
+				EXPECT_EQ(c.ghostsAcrossEdge, 0) << name << " seed " << seed << ": " << c.deepestAcrossWhere;
 			}
 }
 

@@ -1091,6 +1091,116 @@ TEST(ContactDetection, GhostPairsOfTheDepositHaveNoNegativeGap) {
 	}
 }
 
+// A part of a concave block (the unit cube, its face x = 1 shared with the
+// next part: internal) and a box crossing the part's ridge, the edge (x, z) =
+// (1, 1) along y that the top face shares with the internal face: the box's
+// lowest edge, 0.2 m long, runs along (1, 0, -1), h above the ridge along
+// (1, 0, 1) / sqrt(2), slightly turned (a generic placement). Closed form:
+// the two are h apart, separated only along the cross product of the two
+// edges (every face axis shows an overlap: the box's edge dips below the top
+// face's plane beyond the seam). No sub-contact may then have a negative gap,
+// and beyond d0 the pair has no contact. The ridge's axis was left out when
+// its edge lay on an internal face: the pair seemed to overlap by 7 cm (a
+// face axis), and the box's lower corner beyond the seam, below the top
+// face's plane but outside the part, took a gap of -7 cm 0.5 mm apart (as
+// in the roofs of tests/cpp/contact/test_contact_coverage.cpp: -9.2 cm, 3.2
+// cm outside).
+TEST(ContactDetection, InternalEdgesBoundThePenetrationOfAPartAcrossItsRidge) {
+	const Block part = box(Vector3(0, 0, 0), Vector3(1, 1, 1));
+	std::vector<char> internal(part.shape.faces.size(), 0);
+	for (std::size_t f = 0; f < part.shape.faces.size(); ++f)
+		internal[f] = dda::faceNormal(part.vertices, part.shape.faces[f]).x() > 0.5;
+	ASSERT_EQ(std::count(internal.begin(), internal.end(), 1), 1);
+	const Vector3 along = Vector3(1, 0, -1).normalized(), out = Vector3(1, 0, 1).normalized();
+	const Vector3 u = (out + Vector3::UnitY()).normalized(), v = (out - Vector3::UnitY()).normalized();
+	const double d0 = 0.1;
+	const DetectionSettings s = settings(d0);
+	for (const double h : {0.0005, 0.02, 0.08, 0.15}) {
+		SCOPED_TRACE("h = " + std::to_string(h));
+		std::vector<Vector3> corners;
+		const Vector3 edge = Vector3(1, 0.5, 1) + h * out;
+		for (const double t : {-0.1, 0.1})
+			for (const double a : {0.0, 0.5})
+				for (const double b : {0.0, 0.5}) corners.push_back(edge + t * along + a * u + b * v);
+		// Turned by 0.01 rad about the common normal through the edges' crossing.
+		const Block crossing = moved(makeBlock(corners), rotationAbout(out, 0.01),
+		                             edge - rotationAbout(out, 0.01) * edge);
+		const double apart = bruteForceSeparation(part, crossing);
+		ASSERT_NEAR(apart, h, 1e-12);
+		for (const bool swap : {false, true}) {
+			SCOPED_TRACE(swap ? "swapped" : "part first");
+			const dda::BlockGeometry gp{&part.shape, &part.vertices, part.centroid, &internal};
+			const dda::BlockGeometry gc = crossing.geometry();
+			const auto result = swap ? dda::detectPairContacts(gc, gp, s) : dda::detectPairContacts(gp, gc, s);
+			if (h > d0) {
+				EXPECT_FALSE(result.has_value()) << describe(*result);
+				continue;
+			}
+			ASSERT_TRUE(result.has_value());
+			SCOPED_TRACE(describe(*result));
+			EXPECT_FALSE(result->contacts.empty());
+			for (const SubContact& c : result->contacts)
+				EXPECT_GE(c.gap, -kLengthTolerance) << "a sub-contact between blocks " << apart << " m apart";
+		}
+	}
+}
+
+// A box (0.5 x 0.5 x 0.3 m) resting on the unit cube's top face, sunk delta
+// into it, turned by theta about the vertical, its corner P farthest along x
+// eps past the top face's edge x = 1 (eps < 0: on the face), below the top
+// face's plane by delta. Closed form: for eps > 0 P lies outside the cube,
+// eps from its side face x = 1; the overlap's corners near P are where P's
+// two bottom edges cross the cube's edge (x, z) = (1, 1), delta deep. So P's
+// contact is against the side face with gap eps (open), and the two
+// crossings carry -delta; no corner outside the cube has a negative gap.
+// With its edges turned 0.01 rad from the cube's (within the angle
+// tolerance) P stands for the near-parallel edges' contact and keeps -delta
+// on the top face (outsideBeyondFaceEdge, SubContacts.cpp). Before, P took
+// -delta on the top face's plane whatever theta, up to d0 past the edge.
+TEST(ContactDetection, CornerPastAFaceEdgeOutsideTheBlockHasNoNegativeGap) {
+	const Block cube = box(Vector3(0, 0, 0), Vector3(1, 1, 1));
+	const double d0 = 0.1, delta = 1e-3;
+	DetectionSettings s = settings(d0);
+	s.angleTolerance = 0.05;  // World's largest (pairDetectionSettings)
+	for (const double theta : {kPi / 6, 0.01})
+		for (const double eps : {-0.01, 0.001, 0.02, 0.08}) {
+			SCOPED_TRACE("theta " + std::to_string(theta) + ", eps " + std::to_string(eps));
+			const Matrix3 R = rotationAbout(Vector3::UnitZ(), theta);
+			std::vector<Vector3> corners;
+			for (int k = 0; k < 8; ++k)
+				corners.push_back(R * Vector3(k & 1 ? 0.25 : -0.25, k & 2 ? 0.25 : -0.25, k & 4 ? 0.3 : 0.0));
+			int p = 0;
+			for (int k = 1; k < 8; ++k)
+				if (corners[k].x() > corners[p].x() || (corners[k].x() == corners[p].x() && corners[k].z() < corners[p].z()))
+					p = k;
+			const Vector3 shift = Vector3(1 + eps, 0.5, 1 - delta) - corners[p];
+			for (Vector3& x : corners) x += shift;
+			const Block block = makeBlock(corners);
+			const auto result = detect(cube, block, s);
+			ASSERT_TRUE(result.has_value());
+			SCOPED_TRACE(describe(*result));
+			checkInvariants(*result, cube, block, s);
+			const auto pContact = std::find_if(result->contacts.begin(), result->contacts.end(), [&](const SubContact& c) {
+				return c.kind == ContactKind::VertexFace && !c.firstIsA && c.feature1 == p;
+			});
+			ASSERT_NE(pContact, result->contacts.end());
+			if (eps < 0 || theta < s.angleTolerance) {
+				EXPECT_NEAR(pContact->gap, -delta, 1e-12);  // on the top face
+				EXPECT_NEAR(pContact->normal.z(), 1, 1e-12);
+			} else {
+				EXPECT_NEAR(pContact->gap, eps, 1e-12);  // on the side face x = 1
+				EXPECT_NEAR(pContact->normal.x(), 1, 1e-12);
+				int crossings = 0;
+				for (const SubContact& c : result->contacts) {
+					if (c.kind == ContactKind::VertexFace && !c.firstIsA && block.vertices[c.feature1].x() > 1 + kLengthTolerance)
+						EXPECT_GE(c.gap, -kLengthTolerance) << "corner " << c.feature1 << " outside the cube";
+					crossings += c.kind == ContactKind::EdgeEdge && std::abs(c.gap + delta) < 1e-12;
+				}
+				EXPECT_EQ(crossings, 2);
+			}
+		}
+}
+
 // Three pairs the narrow-phase oracle found in its 2,000,000-pair run (seed
 // 20250917, pairs 415996, 666220 and 1160967 of
 // tests/cpp/contact/test_narrow_phase_oracle.cpp), with World's settings for d0 = 1 cm:
