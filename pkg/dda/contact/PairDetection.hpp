@@ -70,6 +70,15 @@
 //      finds some.
 //      A translation of the penetration depth separates the blocks and moves
 //      any gap by at most that depth, so a deeper gap is no contact.
+//      Last, a pair that overlaps (its largest separation, near-parallel edge
+//      axes included, below -lengthTolerance) with no sub-contact of
+//      negative gap gets the contact of its near-parallel edge pair of
+//      largest separation: the point of either edge deepest inside the other
+//      block (the deeper of the two) against that point's own entrance face,
+//      a vertex-face stencil keyed as the two edges' edge-edge contact
+//      (nearParallelEdgeContact, SubContacts.cpp: two edges crossing at an
+//      angle below the tolerance with the ends of both outside the other
+//      block overlap at no corner, and have no crossing contact).
 //      An edge entrance gives its edge-edge sub-contact (block i = A), or
 //      falls back to the best face when the two edges do not cross strictly
 //      inside; the depth bound then stays the edge axis's (the face's own
@@ -213,7 +222,10 @@ struct SubContact {
 	// edge-edge:   feature1 = edge of block i,   feature2 = edge of block j.
 	int feature1 = -1, feature2 = -1;
 	// Start-of-step stencil (vertex-face: the face's chooseFaceCorners triangle,
-	// so the gap below is exactly linearizeNormalDistance's d0).
+	// so the gap below is exactly linearizeNormalDistance's d0). Its kind is
+	// `kind` except for the contact of two near-parallel edges (step 3, last
+	// rule): kind EdgeEdge, stencil VertexFace (pointI, a point of edge i,
+	// against a face of block j), normal that face's.
 	ContactStencil stencil;
 	double gap = 0;  // signed normal distance [m], > 0 apart, < 0 penetrating
 	// Unit normal pointing from block j towards block i: the direction of the

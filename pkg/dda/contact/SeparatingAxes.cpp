@@ -318,7 +318,11 @@ bool searchEdgeAxes(const Prepared& a, const Prepared& b, double d0, double sinT
 			const EdgeAxis axis = edgeAxis(a, ea, b, eb, sinTolerance);
 			if (!axis.valid) continue;
 			if (axis.nearParallel) {
-				axes.nearParallelBest = std::max(axes.nearParallelBest, axis.separation);
+				if (axis.separation > axes.nearParallelBest) {
+					axes.nearParallelBest = axis.separation;
+					axes.nearParallelEdgeA = ea;
+					axes.nearParallelEdgeB = eb;
+				}
 				continue;
 			}
 			if (axis.separation > d0) {

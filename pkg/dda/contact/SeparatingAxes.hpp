@@ -39,6 +39,8 @@ struct AxisSearch {
 	// angle tolerance (not exactly): no entrance and no rejection, as before,
 	// but a bound of the pair's penetration (step 3) [m].
 	double nearParallelBest = -std::numeric_limits<double>::infinity();
+	// The edge pair of nearParallelBest (edge of A, edge of B), -1 when none.
+	int nearParallelEdgeA = -1, nearParallelEdgeB = -1;
 	// The largest separation of an entrance-eligible axis [m].
 	double best() const { return bestEdge.valid ? std::max(bestFace, bestEdge.separation) : bestFace; }
 };

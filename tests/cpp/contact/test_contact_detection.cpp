@@ -167,12 +167,39 @@ void checkInvariants(const PairContacts& r, const Block& a, const Block& b, cons
 		EXPECT_TRUE(c.normal.allFinite() && c.pointI.allFinite() && c.pointJ.allFinite());
 		EXPECT_NEAR(c.normal.norm(), 1, 1e-12);
 		EXPECT_LE(c.gap, s.contactDistance + s.lengthTolerance);
-		EXPECT_EQ(c.kind, c.stencil.kind);
+		// The one sub-contact whose stencil is of the other kind: two edges
+		// parallel within the angle tolerance that overlap with no other
+		// contact, keyed as their edge-edge contact, measured as the point of
+		// edge 1 deepest inside block j against that point's own entrance face
+		// (SubContacts.cpp, nearParallelEdgeContact).
+		const bool nearParallel = c.kind == ContactKind::EdgeEdge && c.stencil.kind == ContactKind::VertexFace;
+		if (!nearParallel) EXPECT_EQ(c.kind, c.stencil.kind);
 		const dda::LinearizedDistance lin = dda::linearizeNormalDistance(c.stencil, bi.centroid, bj.centroid);
 		EXPECT_TRUE(lin.valid);
 		EXPECT_NEAR(c.gap, lin.d0, 1e-12 * std::max(1.0, std::abs(lin.d0)));
 		EXPECT_NEAR(c.gap, c.normal.dot(c.pointI - c.pointJ), kRoundoff);
-		if (c.kind == ContactKind::VertexFace) {
+		if (nearParallel) {
+			const auto& e1 = bi.shape.edges.at(c.feature1);
+			const Vector3 p0 = bi.vertices[e1[0]], p1 = bi.vertices[e1[1]];
+			const double t = (c.pointI - p0).dot(p1 - p0) / (p1 - p0).squaredNorm();
+			EXPECT_TRUE(t >= 0 && t <= 1);
+			EXPECT_NEAR((p0 + t * (p1 - p0) - c.pointI).norm(), 0, kRoundoff);  // on edge 1
+			EXPECT_EQ(c.stencil.points[0], c.pointI);
+			EXPECT_LT(c.gap, -s.lengthTolerance);  // only ever penetrating
+			bool onAFace = false;
+			for (const std::vector<int>& face : bj.shape.faces) {
+				bool all = true;
+				for (int k = 1; k < 4; ++k)
+					all = all && std::any_of(face.begin(), face.end(),
+					                         [&](int v) { return bj.vertices[v] == c.stencil.points[k]; });
+				if (!all) continue;
+				onAFace = true;
+				const dda::VertexFaceResult vf = dda::vertexFaceDistance(c.pointI, bj.vertices, face, 0.0);
+				EXPECT_NEAR((vf.normal - c.normal).norm(), 0, 1e-9);
+				EXPECT_NEAR(c.gap, vf.distance, 1e-9);
+			}
+			EXPECT_TRUE(onAFace);
+		} else if (c.kind == ContactKind::VertexFace) {
 			const std::vector<int>& face = bj.shape.faces.at(c.feature2);
 			EXPECT_EQ(c.stencil.points[0], bi.vertices.at(c.feature1));
 			EXPECT_EQ(c.pointI, bi.vertices.at(c.feature1));
@@ -407,6 +434,53 @@ TEST(ContactDetection, EdgeEdgeParallelGeneric) {
 			}
 		}
 	}
+}
+
+// Two ridges crossing at a small angle, below the angle tolerance: a's top
+// edge (x, 0, 1), x in [-1, 1], and b's bottom edge, 1 long, turned by theta
+// about z and lowered by delta, crossing a's at (0, 0, 1 - delta). With
+// theta x 0.5 > |delta| the ends of either edge lie outside the other
+// block (b's ends 5 mm aside of a's ridge for theta = 0.01), so no corner
+// contact can stand for the overlap, and near-parallel edges give no
+// crossing. Closed form: the deepest point of either ridge inside the other
+// prism is the crossing, delta below the other ridge, at delta / sqrt(2)
+// from both faces at 45 degrees; the pair's penetration depth is delta
+// (along z, the edges' common normal). The pair must have a contact of gap
+// -delta / sqrt(2) (no deeper than the penetration), and none negative when
+// apart. Before nearParallelEdgeContact its lowest gap was positive while
+// the prisms overlapped (the coverage oracle's convex pile, seed 6).
+TEST(ContactDetection, NearParallelEdgesCrossingInsideHaveAContactAsDeepAsTheirOverlap) {
+	const Block a = prismAlongX(-1, 1, 0);
+	const Block b0 = prismAlongX(-0.5, 0.5, 2);
+	DetectionSettings s = settings(1e-3);
+	s.angleTolerance = 0.05;  // World's largest (pairDetectionSettings)
+	for (const double theta : {0.01, 0.03})
+		for (const double delta : {-5e-4, 1e-4, 1e-3, 3e-3})
+			for (const Scene& scene : genericScenes(67, 4)) {
+				SCOPED_TRACE("theta " + std::to_string(theta) + ", delta " + std::to_string(delta));
+				const Matrix3 turn = rotationAbout(Vector3::UnitZ(), theta);
+				const Block b = moved(b0, scene.R * turn, scene.R * Vector3(0, 0, -delta) + scene.o);
+				const Block aMoved = moved(a, scene.R, scene.o);
+				const std::optional<PairContacts> r = detect(aMoved, b, s);
+				ASSERT_TRUE(r.has_value());
+				SCOPED_TRACE(describe(*r));
+				checkInvariants(*r, aMoved, b, s);
+				double lowest = std::numeric_limits<double>::infinity();
+				for (const SubContact& c : r->contacts) lowest = std::min(lowest, c.gap);
+				if (delta < 0) {
+					EXPECT_GE(lowest, -s.lengthTolerance);
+					continue;
+				}
+				ASSERT_FALSE(r->contacts.empty());
+				EXPECT_NEAR(lowest, -delta / std::sqrt(2.0), 1e-9);
+				EXPECT_GE(lowest, -delta - s.lengthTolerance);
+				// It is the edge pair's: a's ridge and b's.
+				const auto ridges = std::find_if(r->contacts.begin(), r->contacts.end(), [&](const SubContact& c) {
+					return c.kind == ContactKind::EdgeEdge && std::abs(c.gap - lowest) < 1e-12;
+				});
+				ASSERT_NE(ridges, r->contacts.end());
+				EXPECT_EQ(ridges->stencil.kind, ContactKind::VertexFace);
+			}
 }
 
 // ------------------------------------------------------------------ edge-face
