@@ -618,7 +618,6 @@ void tiedFaceContacts(const Prepared& a, const Prepared& b, const std::vector<Fa
 	}
 }
 
-
 // The point of edge e of `block` deepest inside `other`: x(t) = start + t
 // (end - start), t in [0, 1], minimising h(t) = max over every face g of
 // `other` of the distance of x(t) above g's plane (the point's signed
