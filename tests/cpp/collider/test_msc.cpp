@@ -337,14 +337,7 @@ TEST(MSCCollider, ShellPairCacheGivesThePairsAndLinkedSetsOfAFullSearch) {
 		ASSERT_EQ(pairsCached, pairsUncached) << "round " << round;
 		EXPECT_EQ(withCache.shellPairs, without.shellPairs);
 		EXPECT_EQ(withCache.subUnitPairs, without.subUnitPairs);
-		for (int p = 0; p < static_cast<int>(pairsCached.size()); ++p)
-			for (int i = 0; i < 2; ++i) {
-				const LinkedSubUnits& x = *cached.linked(p);
-				const LinkedSubUnits& y = *uncached.linked(p);
-				EXPECT_TRUE(std::equal(x.vertices[i].begin(), x.vertices[i].end(), y.vertices[i].begin(), y.vertices[i].end()));
-				EXPECT_TRUE(std::equal(x.edges[i].begin(), x.edges[i].end(), y.edges[i].begin(), y.edges[i].end()));
-				EXPECT_TRUE(std::equal(x.faces[i].begin(), x.faces[i].end(), y.faces[i].begin(), y.faces[i].end()));
-			}
+		EXPECT_TRUE(sameLinkedSets(cached, uncached, static_cast<int>(pairsCached.size()))) << "round " << round;
 		EXPECT_EQ(without.broadPhaseSkipped, 0);
 		skipped += withCache.broadPhaseSkipped;
 		partial += withCache.broadPhaseSkipped && withCache.blocksResearched > 0;
@@ -748,14 +741,7 @@ TEST(MSCCollider, OneAndTwoThreadsFindTheSamePairsAndLinkedSets) {
 		EXPECT_EQ(statsOne.subUnitPairs, statsTwo.subUnitPairs);
 		EXPECT_EQ(statsOne.pairsReused, statsTwo.pairsReused);
 		EXPECT_EQ(statsOne.blocksResearched, statsTwo.blocksResearched);
-		for (int p = 0; p < static_cast<int>(pairsOne.size()); ++p)
-			for (int i = 0; i < 2; ++i) {
-				const LinkedSubUnits& x = *one.linked(p);
-				const LinkedSubUnits& y = *two.linked(p);
-				ASSERT_TRUE(std::equal(x.vertices[i].begin(), x.vertices[i].end(), y.vertices[i].begin(), y.vertices[i].end()));
-				ASSERT_TRUE(std::equal(x.edges[i].begin(), x.edges[i].end(), y.edges[i].begin(), y.edges[i].end()));
-				ASSERT_TRUE(std::equal(x.faces[i].begin(), x.faces[i].end(), y.faces[i].begin(), y.faces[i].end()));
-			}
+		ASSERT_TRUE(sameLinkedSets(one, two, static_cast<int>(pairsOne.size()))) << "round " << round;
 		for (int b = 0; b < static_cast<int>(blocks.size()); ++b) {
 			Block& block = blocks[b];
 			if (block.fixed) continue;
