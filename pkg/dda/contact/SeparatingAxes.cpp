@@ -181,7 +181,13 @@ bool searchFaceAxes(const Prepared& a, const Prepared& b, double d0, double hyst
 	// block. Taken as the entrance, its sub-contacts measured the other's
 	// seam corners and edges across it: a cube sliding over the seam of a
 	// free two-part slab met the seam edge as a step (1.1e5 N, its speed
-	// 1.0 -> 0.34 m/s; tests/py/blocks/test_concave_blocks.py). The rule only
+	// 1.0 -> 0.34 m/s; tests/py/blocks/test_concave_blocks.py). The face ties
+	// with the internal face it opposes (for opposed normals both axes are the
+	// blocks' projected separation on that line), so it is the entrance
+	// whenever that axis separates the pair the most: a cube sunk e into a
+	// two-part slab, its front face within d0 before the seam or less than e
+	// past it, had the seam edge's crossings with normals along the slab
+	// (tests/cpp/contact/test_internal_face_rules.cpp). The rule only
 	// leaves contacts out (no force, no work); the face still rejects.
 	const auto facesInternal = [&](const Prepared& owner, int f, const Prepared& other) {
 		if (!other.internalFaces) return false;

@@ -262,6 +262,25 @@ bool besideVertexContact(const SubContact& crossing, const std::vector<SubContac
 // spring, so leaving it out creates no energy; the one it replaces pushed
 // with a spring stretched by metres. A contact kept has a gap of at least
 // the farthest distance less `reach`: above -reach for q outside `other`.
+// Since the depth bound below, gaps that deep are removed by it as well;
+// what this rule alone decides is a corner below G's plane by e, at most
+// the pair's penetration, more than reach - e across an internal face (the
+// test compares with G's distance, -e, plus reach). Where the internal face
+// meets G at a right angle, q projects within reach of G only up to reach
+// past the seam, so the rule acts in a band of width e just inside reach (a
+// block sunk e into a flush floor leaves a corner past the seam to the
+// neighbour alone from reach - e on, not reach). Where it meets G at an
+// acute ridge, q's projection can fall on G while q lies farther than d0
+// from `other`: a slab sunk 0.45 to 0.9 d0 with corners 1.02 to 1.13 d0
+// past a covered 45-degree ridge took gap -e there without the rule
+// (tests/cpp/contact/test_internal_face_rules.cpp,
+// ACornerMoreThanContactDistanceAcrossAnInternalFaceHasNoContact). Only
+// corners measured here: a corner of the entering block lies on the
+// entrance face, and outsideBeyondFaceEdge counts exposed faces only, so
+// with the covered block's face as the entrance the same corner keeps -e.
+// Energy: at the step the rule acts it only leaves a contact out; a
+// compressed spring it drops leaves the account as a loss (contactChanges),
+// never a gain.
 //
 // Nor is it deeper than the pair's penetration: `lowest` is min(s, 0) less
 // the length tolerance, s the pair's largest separation over every axis
@@ -315,6 +334,15 @@ void ownEntranceContact(const Prepared& block, bool blockIsA, int q, const Prepa
 	// seam of a flush floor) both blocks hold the corner, as before: dropping
 	// it there made the hand-over at the seam abrupt and cost a sliding block
 	// 26% of its kinetic energy (tests/py/contact/test_flush_joint.py).
+	// The wedge's corner, 1.3 cm below G, is now below the depth bound too;
+	// the rule alone decides for q no deeper than the pair's penetration and
+	// within reach - e across each covered face: a slab sunk e into a floor
+	// of four flush blocks, its corner a few mm past the covered corner of
+	// one, outside it and inside the diagonal neighbour, took gap -e against
+	// that block's top without the rule, a compressed spring where the pair
+	// does not overlap (tests/cpp/contact/test_internal_face_rules.cpp,
+	// ACornerPastACoveredCornerOfAFloorBlockHasNoCompressedContact). Like the
+	// rule above it only leaves a contact out: no spring, no energy created.
 	if (bestDistance < -tolerance && bestDistance < farthest - tolerance &&
 	    insideMargin(other, bestFace, x) < -tolerance) {
 		int beyond = 0;
