@@ -126,8 +126,9 @@ std::string describe(const PairContacts& r) {
 // the seam), and none is deeper than e; and the two parts together measure
 // the overlap (a sub-contact of gap -e).
 // The cube's front face x = xf is opposed to the second part's internal face
-// x = 2, and for xf - 2 < e it separates the pair the most: taken as the
-// entrance, it measured the second part's seam edge across it (an edge-edge
+// x = 2 (the two axes tie: both are the blocks' projected separation along
+// x), and from d0 before the seam to e past it (xf - 2 < e) that axis
+// separates the pair the most: taken as the entrance, it measured the second part's seam edge across it (an edge-edge
 // contact with normal x, gap 2 - xf, before the seam as after it).
 TEST(InternalFaceRules, ACubeOnTheSeamOfATwoPartSlabIsPushedOnlyAlongTheSlabsNormal) {
 	const double d0 = 0.01;
