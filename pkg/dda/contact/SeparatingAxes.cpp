@@ -187,7 +187,9 @@ bool searchFaceAxes(const Prepared& a, const Prepared& b, double d0, double hyst
 	// whenever that axis separates the pair the most: a cube sunk e into a
 	// two-part slab, its front face within d0 before the seam or less than e
 	// past it, had the seam edge's crossings with normals along the slab
-	// (tests/cpp/contact/test_internal_face_rules.cpp). The rule only
+	// (tests/cpp/contact/test_internal_face_rules.cpp); a frictionless block
+	// crossing a flush joint of two fixed blocks at 5 m/s kept 26% of its
+	// kinetic energy (tests/py/contact/test_flush_joint.py). The rule only
 	// leaves contacts out (no force, no work); the face still rejects.
 	const auto facesInternal = [&](const Prepared& owner, int f, const Prepared& other) {
 		if (!other.internalFaces) return false;
