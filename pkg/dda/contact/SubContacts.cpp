@@ -761,6 +761,26 @@ DeepestEdgePoint deepestEdgePoint(const Prepared& block, int e, const Prepared& 
 // had no spring before). That first-step gain remains: the pair has no open
 // contact within d0 before it overlaps, so the overlap's first step, up to
 // the step's relative motion, is met compressed.
+// Tried and not kept (branch helper-npar; the oracle's 48 scenes, 8 seeds:
+// sum of the steps' gains 2.96e6 J, largest single step 2.26e5 J before):
+// the same contact made while the pair is within d0, open at a positive gap.
+// (1) At any point of the edge: the point of an edge nearest the other
+// block is mostly its end, a corner with its own vertex-face contact, whose
+// spring it doubled (~15,000 contact-steps per convex pile); seed 6 fell to
+// 5.2e4 J, but 37 scenes changed, sum 2.90e6 J, one scene 3.7e4 -> 2.6e5 J.
+// (2) Only at a point more than the corner merge distance inside the edge
+// (it reproduces the 1.39e6 J an earlier attempt measured): the rule acts
+// only while no sub-contact is negative, so a corner 0.5 m away closing at
+// -51 um switched it off; in that step the crossing went unresisted and
+// came back 2.64 mm deep as a new contact, 1.39e6 J (convex seed 1, E =
+// 1e10 Pa, parts 22 and 23; sum 4.22e6 J). (3) As (2), a negative
+// sub-contact farther than d0 from the point no longer switching it off:
+// one point cannot hold two near-parallel edges, whose crossing moves
+// along them by their offset / angle as the blocks turn; the deepest point
+// moved 0.5 m in a step and was met 0.93 mm deep while the old point ended
+// 5 um deep (convex seed 3, E = 1e10 Pa, parts 13 and 14: 1.74e5 J; 13
+// scenes raised, sum 3.06e6 J). An open contact for such a pair would have
+// to hold the line (its ends and the crossing), not a point.
 std::optional<SubContact> nearParallelEdgeContact(const Prepared& a, int edgeA, const Prepared& b, int edgeB,
                                                   double tolerance, double lowest) {
 	const DeepestEdgePoint inB = deepestEdgePoint(a, edgeA, b, tolerance);

@@ -133,6 +133,36 @@ double partSeparation(const Block& a, const std::vector<Vector3>& ca, const Part
 	return best;
 }
 
+// The point of segment [p0, p1] deepest inside a convex part: x(t) = p0 + t
+// (p1 - p0), t in [0, 1], minimising signedDistance(planes, x(t)), which is
+// convex and piecewise affine in t; its minimum lies at an end or where two
+// faces' distances are equal, and every such t is tried. Returns t and the
+// signed distance there [m] (< 0 inside).
+std::pair<double, double> deepestSegmentPoint(const PartPlanes& planes, const Vector3& p0, const Vector3& p1) {
+	const std::size_t faces = planes.normals.size();
+	std::vector<double> at0(faces), slope(faces);
+	for (std::size_t g = 0; g < faces; ++g) {
+		at0[g] = planes.normals[g].dot(p0 - planes.points[g]);
+		slope[g] = planes.normals[g].dot(p1 - planes.points[g]) - at0[g];
+	}
+	std::pair<double, double> best{0, std::numeric_limits<double>::infinity()};
+	const auto tryAt = [&](double t) {
+		double h = -std::numeric_limits<double>::infinity();
+		for (std::size_t g = 0; g < faces; ++g) h = std::max(h, at0[g] + t * slope[g]);
+		if (h < best.second) best = {t, h};
+	};
+	tryAt(0);
+	tryAt(1);
+	for (std::size_t g = 0; g < faces; ++g)
+		for (std::size_t k = g + 1; k < faces; ++k) {
+			const double denominator = slope[g] - slope[k];
+			if (denominator == 0) continue;
+			const double t = (at0[k] - at0[g]) / denominator;
+			if (t > 0 && t < 1) tryAt(t);
+		}
+	return best;
+}
+
 double diagonal(const std::vector<Vector3>& corners) {
 	Eigen::AlignedBox3d box;
 	for (const Vector3& x : corners) box.extend(x);
@@ -189,6 +219,18 @@ struct Coverage {
 	long overlapsUnpushed = 0;
 	double deepestUnpushed = 0;  // [m]
 	std::string deepestUnpushedWhere;
+	// Near-parallel edges crossing beside a push: two parts that overlap and
+	// have a sub-contact of negative gap, with an edge pair parallel within the
+	// angle tolerance (not exactly) of which a point of one edge, strictly
+	// inside it (farther than the corner merge distance from its ends), lies
+	// inside the other part by more than the tolerance while no sub-contact
+	// of negative gap has a point within d0 of it. The overlap there has no
+	// spring of its own: nearParallelEdgeContact (SubContacts.cpp) acts only
+	// when no sub-contact of the pair is negative, and a push elsewhere lets
+	// the blocks turn about it. Printed, not asserted.
+	long nearParallelBeside = 0;
+	double deepestBeside = 0;  // [m]
+	std::string deepestBesideWhere;
 	double largestGain = 0;  // [J], of one step
 	int largestGainStep = -1;
 	double d0 = 0;
@@ -310,7 +352,57 @@ Coverage measure(World& world, int steps, double tolerance) {
 				const double sep = partSeparation(world.block(p), corners[p], planes[p], world.block(q), corners[q], planes[q]);
 				if (!(sep < -tolerance)) continue;
 				const auto lowest = pairLowest.find({p, q});
-				if (lowest != pairLowest.end() && lowest->second < 0) continue;
+				if (lowest != pairLowest.end() && lowest->second < 0) {
+					// Near-parallel edges crossing beside the pair's push.
+					const double minDiagonal = std::min(diagonal(corners[p]), diagonal(corners[q]));
+					const double parallelSine =
+					    std::sin(std::clamp(2 * stats.allowedDisplacement / minDiagonal, 1e-6, 0.05));
+					const double merge = 1e-3 * minDiagonal;
+					std::vector<Vector3> pushed;  // points of the pair's contacts of negative gap
+					for (const Contact& c : world.contacts())
+						if (std::min(c.key.blockI, c.key.blockJ) == p && std::max(c.key.blockI, c.key.blockJ) == q &&
+						    c.geometry.gap < 0) {
+							pushed.push_back(c.geometry.pointI);
+							pushed.push_back(c.geometry.pointJ);
+						}
+					double deepest = 0;
+					Vector3 where = Vector3::Zero();
+					const Block& bp = world.block(p);
+					const Block& bq = world.block(q);
+					for (const auto& ep : bp.shape->edges)
+						for (const auto& eq : bq.shape->edges) {
+							const Vector3 dp = corners[p][ep[1]] - corners[p][ep[0]];
+							const Vector3 dq = corners[q][eq[1]] - corners[q][eq[0]];
+							const double cross = dp.cross(dq).norm();
+							if (!(cross > 0) || cross > parallelSine * dp.norm() * dq.norm()) continue;
+							for (int side = 0; side < 2; ++side) {
+								const Vector3& a0 = side == 0 ? corners[p][ep[0]] : corners[q][eq[0]];
+								const Vector3& a1 = side == 0 ? corners[p][ep[1]] : corners[q][eq[1]];
+								const auto [t, h] = deepestSegmentPoint(side == 0 ? planes[q] : planes[p], a0, a1);
+								const double length = (a1 - a0).norm();
+								if (!(h < -tolerance) || !(t * length > merge && (1 - t) * length > merge)) continue;
+								const Vector3 x = a0 + t * (a1 - a0);
+								if (std::any_of(pushed.begin(), pushed.end(),
+								                [&](const Vector3& y) { return (y - x).norm() <= stats.contactDistance; }))
+									continue;
+								if (-h > deepest) {
+									deepest = -h;
+									where = x;
+								}
+							}
+						}
+					if (deepest > 0) {
+						++result.nearParallelBeside;
+						if (deepest > result.deepestBeside) {
+							result.deepestBeside = deepest;
+							char text[200];
+							std::snprintf(text, sizeof text, "step %d: parts %d and %d at (%.3f %.3f %.3f), lowest gap of their contacts %.3g m",
+							              step, p, q, where.x(), where.y(), where.z(), lowest->second);
+							result.deepestBesideWhere = text;
+						}
+					}
+					continue;
+				}
 				++result.overlapsUnpushed;
 				if (-sep > result.deepestUnpushed) {
 					result.deepestUnpushed = -sep;
@@ -427,6 +519,9 @@ void print(const char* name, unsigned seed, const Coverage& c) {
 	            c.beyondOther, c.ghostsAlongEdge, c.ghostsAcrossEdge, -c.deepestAcross, c.deepestAcrossWhere.c_str());
 	std::printf("  %ld pair instances overlapping with no negative gap among their contacts, deepest %.3g m [%s]\n",
 	            c.overlapsUnpushed, c.deepestUnpushed, c.deepestUnpushedWhere.c_str());
+	std::printf("  %ld pair instances with near-parallel edges crossing inside the other part with no push within d0 while "
+	            "another contact of the pair pushes, deepest %.3g m [%s]\n",
+	            c.nearParallelBeside, c.deepestBeside, c.deepestBesideWhere.c_str());
 	std::printf("  energy account: contactChanges %.4g J (steps' gains %.4g J, losses %.4g J; largest gain %.4g J at "
 	            "step %d)\n",
 	            c.contactChanges, c.contactGains, c.contactLosses, c.largestGain, c.largestGainStep);
@@ -443,11 +538,17 @@ TEST(ContactCoverage, CornersInsideAnotherBlockHaveContacts) {
 	for (const unsigned seed : seeds)
 		for (const int kind : {0, 1, 2})  // concave, convex, roofs
 			for (const double young : {1e8, 1e10}) {
-				World world = randomConcavePile(seed, kind != 1, young, kind == 2);
-				const Coverage c = measure(world, 700, 2e-6);
 				char name[64];
 				std::snprintf(name, sizeof name, "%s E=%.0e", kind == 0 ? "concave" : kind == 1 ? "convex" : "roofs",
 				              young);
+				// One scene of the run, for a diagnosis: DDA_COVERAGE_SCENE its printed
+				// name ("convex E=1e+10"), DDA_COVERAGE_SEED its seed.
+				const char* only = std::getenv("DDA_COVERAGE_SCENE");
+				const char* onlySeed = std::getenv("DDA_COVERAGE_SEED");
+				if ((only && std::string(only) != name) || (onlySeed && std::atoi(onlySeed) != static_cast<int>(seed)))
+					continue;
+				World world = randomConcavePile(seed, kind != 1, young, kind == 2);
+				const Coverage c = measure(world, 700, 2e-6);
 				print(name, seed, c);
 				EXPECT_EQ(c.uncovered, 0) << name << " seed " << seed << ": " << c.deepestWhere;
 				EXPECT_EQ(c.newDeep, 0) << name << " seed " << seed << ": " << c.deepestNewWhere;
