@@ -18,6 +18,11 @@ assert and what it costs:
   wall and CPU seconds (this process; on a shared machine the CPU time is the
   fairer measure).
 
+--hulls N: the random convex hulls of test_energy_and_creep.py instead (27 hulls of 4 to
+12 random points in a fixed box), seeds 1..N at 1e9 and 1e11 Pa (or --youngs), 1 s (or
+--time): the contact changes between steps, net, their gains and the largest single
+step's, over the largest change of any account term; writes bench/out/energy_hulls.json.
+
 Writes bench/out/energy.json and prints a table. SI units.
 Run: make bench (or /usr/bin/python3 bench/energy.py [--youngs 1e5 1e11] [--time 0.6];
 YADE_DDA_BUILD=<build>/py to use a build tree instead of the installed package).
@@ -168,6 +173,48 @@ def run(young, duration, count=30, side=None, threads=0, every=10, progress=None
     return row
 
 
+def run_hulls(young, seed, duration, threads=0):
+    """The random-hull pile of test_energy_and_creep.py (27 hulls of 4 to 12 random points
+    dropped into a fixed box, that test's builder) for `duration` s, every step: the
+    contactChanges between steps (net, summed gains, the largest single step and when),
+    over the largest change of any account term; the account's drift; kinetic plus
+    potential energy's largest rise; steps and CPU seconds."""
+    from test_energy_and_creep import hull_pile
+    O.reset()
+    blocks = hull_pile(27, young, seed)
+    O.engines = [DDAIntegrator(gravity=(0, 0, -G), threads=threads, label='dda')]
+    cpuStart = time.process_time()
+    O.step()
+    a0 = dict(yade_dda.stats()['energy'])
+
+    def kp(a):
+        return a['kinetic'] + a['gravity']
+
+    def account(e):
+        return e['kinetic'] + e['gravity'] + e['strain'] + e['contact'] + e['friction'] + e['damping'] - e['loads']
+
+    prev, gains, largest, largestAt, rise, steps = a0['contactChanges'], 0.0, 0.0, 0.0, 0.0, 1
+    while O.time < duration:
+        O.step()
+        steps += 1
+        a = yade_dda.stats()['energy']
+        change = a['contactChanges'] - prev
+        prev = a['contactChanges']
+        if change > 0:
+            gains += change
+        if change > largest:
+            largest, largestAt = change, O.time
+        rise = max(rise, kp(a) - kp(a0))
+    a = yade_dda.stats()['energy']
+    scale = max(abs(a[k] - a0[k]) for k in a)
+    drift = account(a) - account(a0) - (a['contactChanges'] - a0['contactChanges'])
+    return dict(young=young, seed=seed, blocks=len(blocks), time=O.time, steps=steps, scale=scale,
+                contactChanges=(a['contactChanges'] - a0['contactChanges']) / scale, gains=gains / scale,
+                largestStepGain=largest / scale, largestStepGainJ=largest, largestAt=largestAt,
+                accountDrift=drift / scale, kineticPlusPotentialRise=rise / scale,
+                cpuSeconds=time.process_time() - cpuStart)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--youngs', type=float, nargs='+', default=[1e5, 1e7, 1e9, 1e11])
@@ -182,8 +229,24 @@ def main():
                         help='with --count/--pile200: stop a run once a block is this many times its free-fall bound')
     parser.add_argument('--stop-gain', type=float, default=0.5,
                         help='with --count/--pile200: stop a run once gainFull is above this (blown up)')
+    parser.add_argument('--hulls', type=int, default=None, metavar='N',
+                        help='the random-hull pile of test_energy_and_creep.py, seeds 1..N (default E: 1e9 1e11)')
     parser.add_argument('--out', default=os.path.join(os.path.dirname(os.path.abspath(__file__)), 'out'))
     args = parser.parse_args()
+    if args.hulls:
+        youngs = args.youngs if '--youngs' in sys.argv else [1e9, 1e11]
+        rows = [run_hulls(E, seed, args.time or 1.0, args.threads) for E in youngs
+                for seed in range(1, args.hulls + 1)]
+        os.makedirs(args.out, exist_ok=True)
+        with open(os.path.join(args.out, 'energy_hulls.json'), 'w') as f:
+            json.dump(dict(rows=rows), f, indent=1)
+        print('%8s %4s %6s %10s %10s %12s %8s %9s %9s' % ('E [Pa]', 'seed', 'steps', 'changes', 'gains',
+                                                         'largest step', 'at [s]', 'drift', 'rise'))
+        for r in rows:
+            print('%8.0e %4d %6d %10.2e %10.2e %12.2e %8.3f %9.1e %9.1e' % (
+                r['young'], r['seed'], r['steps'], r['contactChanges'], r['gains'], r['largestStepGain'],
+                r['largestAt'], r['accountDrift'], r['kineticPlusPotentialRise']))
+        return
     if args.pile200:
         args.count, args.side = 200, 5
     big = args.count is not None

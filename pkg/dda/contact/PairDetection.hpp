@@ -91,7 +91,15 @@
 //      corner within d0 as well, and with the crossing alone that corner
 //      would enter the other block unopposed. What the face finds at the
 //      crossing (the same edges, or a point within cornerMergeDistance of
-//      it) is left to the crossing. Edge-edge stencils take as reference direction (from block i
+//      it) is left to the crossing. And where either entrance edge runs on
+//      across a face at the other entrance edge, its crossings with that
+//      face's other edges are edge-edge sub-contacts by the face-entrance
+//      rules above (edge of the crossing block as i, within d0, normal
+//      within 60 degrees of that face's, no deeper than the bound, not
+//      beside a vertex contact or the entrance crossing): the second point
+//      of an edge lying across a face, which the best face finds only when
+//      it is that face (crossingsAcrossEntranceFaces, SubContacts.cpp).
+//      Edge-edge stencils take as reference direction (from block i
 //      towards block j) the sum of the outward normals of the faces at i's
 //      edge minus that at j's edge.
 //   4. Structural type from the contact features: on each block, the points

@@ -587,6 +587,68 @@ void otherFeaturesOfEdgeEntrance(const Prepared& a, const Prepared& b, const Ent
 	out.erase(std::remove_if(out.begin() + static_cast<std::ptrdiff_t>(first), out.end(), sameAsCrossing), out.end());
 }
 
+// Step 3 for an edge entrance whose edges cross (out[0] the crossing): where
+// either entrance edge, past the crossing, runs on across a face at the other
+// entrance edge, its crossing of that face's boundary further on. Two blocks
+// meeting edge on edge touch at one point only while neither edge lies across
+// the other's face; once edge b crosses edge a and continues over a face F at
+// a, the pair touches along b over F (an edge-on-face contact), and F's
+// boundary crosses b a second time. The best face's search finds that second
+// crossing only when F is the best face, which an edge axis beat and which
+// may lie elsewhere on the block: with the entrance crossing alone, b pivots
+// about it and drives its other crossing into F's block within a step
+// (random hulls at E = 1e11 Pa: a crossing found first at 0.88 mm deep, 4.0e5
+// J in its spring; measured in session 9, doc/benchmarks.md). Each such
+// crossing is the edge-edge contact the face search would give were F the
+// entrance (edge of the block crossing F as i, F's edge as j, normal within
+// 60 degrees of F's, no deeper than the pair's penetration, not beside a
+// vertex contact or the entrance crossing), found while it is within d0.
+// Energy: a crossing added open stores nothing; one already compressed is no
+// deeper than the pair's penetration (its spring is booked as a contact
+// change); none is closed, deepened or dropped by the rule.
+void crossingsAcrossEntranceFaces(const Prepared& a, const Prepared& b, int edgeA, int edgeB, double crossingBound,
+                                  const DetectionSettings& settings, double sinTolerance,
+                                  std::vector<SubContact>& out) {
+	const SubContact crossing = out.front();
+	const double reach = settings.contactDistance + settings.lengthTolerance;
+	const double merge = std::max(settings.cornerMergeDistance, settings.lengthTolerance);
+	EdgeContactLimits limits;
+	limits.highestGap = reach;
+	limits.deepestGap = std::min(crossingBound, 0.0) - settings.lengthTolerance;
+	limits.minCosine = kEdgeNormalMinCosine;
+	const auto known = [&](const SubContact& c) {
+		for (const SubContact& o : out)
+			if (o.kind == ContactKind::EdgeEdge && o.stencil.kind == ContactKind::EdgeEdge &&
+			    ((o.feature1 == c.feature1 && o.feature2 == c.feature2 && o.firstIsA == c.firstIsA) ||
+			     (o.feature1 == c.feature2 && o.feature2 == c.feature1 && o.firstIsA != c.firstIsA)))
+				return true;
+		for (const Vector3* p : {&c.pointI, &c.pointJ})
+			if ((*p - crossing.pointI).norm() <= merge || (*p - crossing.pointJ).norm() <= merge) return true;
+		return besideVertexContact(c, out, merge);
+	};
+	for (int side = 0; side < 2; ++side) {
+		// The faces of `owner` at its entrance edge, crossed by the other block's entrance edge.
+		const Prepared& owner = side == 0 ? a : b;
+		const Prepared& other = side == 0 ? b : a;
+		const int ownEdge = side == 0 ? edgeA : edgeB, otherEdge = side == 0 ? edgeB : edgeA;
+		for (int f : owner.shape->edgeFaces[ownEdge]) {
+			if (f < 0 || owner.internal(f)) continue;
+			ensurePlane(owner, f);
+			limits.direction = &owner.faces[f].normal;
+			for (int g : owner.edgeList) {
+				if (g == ownEdge) continue;
+				const auto& gf = owner.shape->edgeFaces[g];
+				if (gf[0] != f && gf[1] != f) continue;
+				++*owner.tests;
+				const std::optional<SubContact> c =
+				    edgeEdgeContact(side != 0, other, otherEdge, owner, g, settings, sinTolerance, limits);
+				if (!c || planeDistance(owner, f, c->pointI) > reach || known(*c)) continue;
+				out.push_back(*c);
+			}
+		}
+	}
+}
+
 // Step 3 for an edge entrance whose two edges do not cross strictly inside,
 // after the best face's contacts (the fallback): the ends of the two edges,
 // each against its own entrance face of the other block (ownEntranceContact).
@@ -864,6 +926,8 @@ void findSubContacts(const Prepared& a, const Prepared& b, const std::vector<Fac
 			out.contacts.push_back(*c);
 			otherFeaturesOfEdgeEntrance(a, b, chooseFace(faces, a, b, tol, previous).feature, depthBound,
 			                            crossingBound, settings, sinTolerance, s, out.contacts);
+			crossingsAcrossEntranceFaces(a, b, entrance.feature.feature, entrance.feature.other, crossingBound, settings,
+			                             sinTolerance, out.contacts);
 		} else {
 			// The edges do not cross strictly inside (a corner meets an edge),
 			// or their crossing is deeper than the bound: the best face is the

@@ -109,6 +109,69 @@ def test_dropped_pile_never_gains_energy(scene, young):
     assert share <= 1e-3, (share, when)
 
 
+def hull_pile(n, young, seed, friction=30.0, width=3.0):
+    """n blocks, each the convex hull of 4 to 12 random points in a 0.8 x 0.8 x 0.7 m box,
+    in layers of 3 x 3 over the floor of a fixed open box `width` m wide (walls 3 m high):
+    shapes nobody designed, with triangles, short edges and faces at every angle."""
+    rng = random.Random(seed)
+    rock = O.materials.append(wrapper.PolyhedraMat(density=2600, young=young, poisson=0.25,
+                                                   frictionAngle=math.radians(friction)))
+    W = width
+    for lo, hi in [((-.5, -.5, -.5), (W + .5, W + .5, 0)), ((-.5, -.5, 0), (0, W + .5, 3)),
+                   ((W, -.5, 0), (W + .5, W + .5, 3)), ((0, -.5, 0), (W, 0, 3)), ((0, W, 0), (W, W + .5, 3))]:
+        O.bodies.append(yade_dda.ddaBlock(box(lo, hi), material=rock, fixed=True))
+    blocks = []
+    for k in range(n):
+        c = (0.5 + k % 3, 0.5 + k // 3 % 3, 0.6 + 0.9 * (k // 9))
+        pts = [(c[0] + rng.uniform(-.4, .4), c[1] + rng.uniform(-.4, .4), c[2] + rng.uniform(-.35, .35))
+               for _ in range(rng.randint(4, 12))]
+        blocks.append(O.bodies.append(yade_dda.ddaBlock(pts, material=rock, hull=True)))
+    return blocks
+
+
+@pytest.mark.parametrize('young', [1e9, 1e11])
+def test_random_hulls_dropped_into_a_box_keep_the_energy_account(scene, young):
+    """27 convex hulls of random points dropped into a fixed box, every setting at its
+    default (an unseen scene: the README's own kind of script). Oracles: every hull is
+    accepted; no block is faster than a fall from the top of the pile allows; kinetic
+    plus potential energy never rises above its start by 0.1%; damping and friction
+    never negative; the account balances to 1e-3 of the largest change. Contact changes
+    between steps should add no energy beyond 1e-3 of the largest change. Measured in
+    session 9 (seeds 1-8, 1.5 s): 0.2 to 2.5% at 1e9 Pa (0.46 at one seed) and 11 to 96% at
+    1e11 Pa. Two mechanisms, both measured contact by contact (doc/benchmarks.md,
+    "Energy of random hulls"): contacts kept from step to step whose next start, on the
+    moved geometry, is deeper than the step's linearised gap said (an edge-edge gap at a
+    small crossing angle is far from linear in the blocks' turns: 4.6 um at the start of
+    the next step where the step's model said 0.01 um), and crossings found only once
+    already deep (an edge entrance's second crossing of the same edge, 0.88 mm, 4.0e5 J
+    in one step). Reported as an expected failure while it is so, not hidden."""
+    print('seed', SEED)
+    cubes = hull_pile(27, young, SEED)
+    O.engines = [DDAIntegrator(gravity=(0, 0, -G), label='dda')]
+    O.run(1, True)
+    e0, _ = translational(cubes)
+    top = max(yade_dda.block(b).centroid[2] for b in cubes)
+    vmax = math.sqrt(2 * G * top)
+    a0 = yade_dda.stats()['energy']
+    worst, changes = 0.0, []
+    while O.time < 1.0:
+        O.run(25, True)
+        e, fastest = translational(cubes)
+        assert math.isfinite(e) and fastest <= vmax, (O.time, fastest, vmax)
+        worst = max(worst, (e - e0) / abs(e0))
+        a = yade_dda.stats()['energy']
+        assert a['damping'] >= 0 and a['friction'] >= 0
+        scale = largest(a, a0)
+        drift = account(a) - account(a0) - (a['contactChanges'] - a0['contactChanges'])
+        assert abs(drift) <= 1e-3 * scale, (O.time, drift, scale)
+        changes.append(((a['contactChanges'] - a0['contactChanges']) / scale, O.time))
+    assert worst <= 1e-3, worst
+    share, when = max(changes)
+    if share > 1e-3:
+        pytest.xfail('contact changes between steps added %.2g of the largest change by t = %.2f s (random '
+                     'hulls at %g Pa; see the docstring)' % (share, when, young))
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize('young', [1e5, 1e7, 1e9, 1e11])
 def test_pile_of_200_cubes_never_gains_energy(scene, young):
