@@ -7,6 +7,7 @@
 #include "dda/collider/Collider.hpp"
 #include "dda/collider/ColliderFactory.hpp"
 #include "dda/contact/PairDetection.hpp"
+#include "dda/geometry/ConvexPolyhedron.hpp"
 #include "dda/solver/World.hpp"
 
 #include <gtest/gtest.h>
@@ -18,6 +19,7 @@
 #include <memory>
 #include <random>
 #include <set>
+#include <sstream>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -226,6 +228,57 @@ inline ContactSet contactSet(Collider& collider, const std::vector<Block>& block
 			out.insert({a, b, static_cast<int>(c.kind), c.firstIsA, c.feature1, c.feature2});
 	}
 	return out;
+}
+
+// A block as the narrow phase alone sees it: topology, corners and their mean
+// as the centroid [m]; `internal` marks faces covered by a neighbour (empty:
+// none).
+struct NarrowBlock {
+	ConvexPolyhedron shape;
+	std::vector<Vector3> vertices;
+	Vector3 centroid = Vector3::Zero();
+	std::vector<char> internal;
+	BlockGeometry geometry() const {
+		const bool any = std::find(internal.begin(), internal.end(), 1) != internal.end();
+		return {&shape, &vertices, centroid, any ? &internal : nullptr};
+	}
+};
+
+// The convex hull of `points` as a NarrowBlock (no internal faces).
+inline NarrowBlock narrowBlock(const std::vector<Vector3>& points) {
+	NarrowBlock b;
+	b.shape = buildConvexPolyhedron(points);
+	b.vertices = b.shape.vertices;
+	for (const Vector3& p : points) b.centroid += p;
+	b.centroid /= static_cast<double>(points.size());
+	b.internal.assign(b.shape.faces.size(), 0);
+	return b;
+}
+
+// The identity, then `count` random rotations (unit quaternions of Gaussian
+// components drawn with `seed`): a placement's closed form is invariant under
+// them, so the narrow phase's answer must be too.
+inline std::vector<Eigen::Matrix3d> sceneRotations(unsigned seed, int count) {
+	std::vector<Eigen::Matrix3d> out{Eigen::Matrix3d::Identity()};
+	std::mt19937 rng(seed);
+	std::normal_distribution<double> normal(0.0, 1.0);
+	for (int k = 0; k < count; ++k) {
+		Eigen::Quaterniond q(normal(rng), normal(rng), normal(rng), normal(rng));
+		out.push_back(q.normalized().toRotationMatrix());
+	}
+	return out;
+}
+
+// A pair's entrance and sub-contacts, for failure messages.
+inline std::string describePair(const PairContacts& r) {
+	std::ostringstream out;
+	out << "entrance kind " << r.entrance.kind << " feature " << r.entrance.feature << ", separation "
+	    << r.separation << ", " << r.contacts.size() << " sub-contacts:";
+	for (const SubContact& c : r.contacts)
+		out << "\n  " << (c.kind == ContactKind::VertexFace ? "VF" : "EE") << " i=" << (c.firstIsA ? "A" : "B")
+		    << " features " << c.feature1 << "/" << c.feature2 << " gap " << c.gap << " normal "
+		    << c.normal.transpose() << " pointI " << c.pointI.transpose();
+	return out.str();
 }
 
 }  // namespace dda::testing

@@ -10,6 +10,7 @@
 // checks the hit/miss transition at exactly d0 (as libccd's boxbox tests);
 // random boxes and tetrahedra near contact check the invariants against a
 // brute-force separating-axis twin.
+#include "TestScenes.hpp"
 #include "dda/contact/Distance.hpp"
 #include "dda/contact/Linearization.hpp"
 #include "dda/contact/PairDetection.hpp"
@@ -45,21 +46,9 @@ constexpr double kLengthTolerance = 1e-8;  // [m]
 constexpr double kRoundoff = 1e-12;        // [m], round-off of unit-sized coordinates
 
 // A block: its topology and current corners, as the narrow phase sees it.
-struct Block {
-	dda::ConvexPolyhedron shape;
-	std::vector<Vector3> vertices;
-	Vector3 centroid = Vector3::Zero();
-	dda::BlockGeometry geometry() const { return {&shape, &vertices, centroid}; }
-};
+using Block = dda::testing::NarrowBlock;
 
-Block makeBlock(const std::vector<Vector3>& points) {
-	Block b;
-	b.shape = dda::buildConvexPolyhedron(points);
-	b.vertices = b.shape.vertices;
-	for (const Vector3& p : points) b.centroid += p;
-	b.centroid /= static_cast<double>(points.size());
-	return b;
-}
+Block makeBlock(const std::vector<Vector3>& points) { return dda::testing::narrowBlock(points); }
 
 // x -> R x + o applied to every corner.
 Block moved(const Block& b, const Matrix3& R, const Vector3& o) {

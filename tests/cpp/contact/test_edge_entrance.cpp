@@ -22,16 +22,14 @@
 // both closest points inside both segments (computed here, independently of
 // the narrow phase). The scene is also turned by random rotations (seed
 // printed) and given in both orders. Units: m.
+#include "TestScenes.hpp"
 #include "dda/contact/PairDetection.hpp"
-#include "dda/geometry/ConvexPolyhedron.hpp"
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
-#include <random>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -39,59 +37,23 @@ namespace {
 
 using dda::ContactKind;
 using dda::DetectionSettings;
-using dda::PairContacts;
 using dda::SubContact;
 using dda::Vector3;
 using Matrix3 = Eigen::Matrix3d;
 
 constexpr unsigned kSeed = 20261126;  // the random rotations'
 
-struct Block {
-	dda::ConvexPolyhedron shape;
-	std::vector<Vector3> vertices;
-	Vector3 centroid = Vector3::Zero();
-	dda::BlockGeometry geometry() const { return {&shape, &vertices, centroid, nullptr}; }
-	// The edge joining corners p and q (given as points), -1 when none.
-	int edgeBetween(const Vector3& p, const Vector3& q) const {
-		for (std::size_t e = 0; e < shape.edges.size(); ++e) {
-			const Vector3& a = vertices[shape.edges[e][0]];
-			const Vector3& b = vertices[shape.edges[e][1]];
-			if (((a - p).norm() < 1e-12 && (b - q).norm() < 1e-12) || ((a - q).norm() < 1e-12 && (b - p).norm() < 1e-12))
-				return static_cast<int>(e);
-		}
-		return -1;
+using Block = dda::testing::NarrowBlock;
+
+// The edge of `b` joining corners p and q (given as points), -1 when none.
+int edgeBetween(const Block& b, const Vector3& p, const Vector3& q) {
+	for (std::size_t e = 0; e < b.shape.edges.size(); ++e) {
+		const Vector3& u = b.vertices[b.shape.edges[e][0]];
+		const Vector3& v = b.vertices[b.shape.edges[e][1]];
+		if (((u - p).norm() < 1e-12 && (v - q).norm() < 1e-12) || ((u - q).norm() < 1e-12 && (v - p).norm() < 1e-12))
+			return static_cast<int>(e);
 	}
-};
-
-Block makeBlock(const std::vector<Vector3>& points) {
-	Block b;
-	b.shape = dda::buildConvexPolyhedron(points);
-	b.vertices = b.shape.vertices;
-	for (const Vector3& p : points) b.centroid += p;
-	b.centroid /= static_cast<double>(points.size());
-	return b;
-}
-
-std::vector<Matrix3> rotations(int count) {
-	std::vector<Matrix3> out{Matrix3::Identity()};
-	std::mt19937 rng(kSeed);
-	std::normal_distribution<double> normal(0.0, 1.0);
-	for (int k = 0; k < count; ++k) {
-		Eigen::Quaterniond q(normal(rng), normal(rng), normal(rng), normal(rng));
-		out.push_back(q.normalized().toRotationMatrix());
-	}
-	return out;
-}
-
-std::string describe(const PairContacts& r) {
-	std::ostringstream out;
-	out << "entrance kind " << r.entrance.kind << ", separation " << r.separation << ", " << r.contacts.size()
-	    << " sub-contacts:";
-	for (const SubContact& c : r.contacts)
-		out << "\n  " << (c.kind == ContactKind::VertexFace ? "VF" : "EE") << " i=" << (c.firstIsA ? "A" : "B")
-		    << " features " << c.feature1 << "/" << c.feature2 << " gap " << c.gap << " normal "
-		    << c.normal.transpose();
-	return out.str();
+	return -1;
 }
 
 // Distance of segments p0p1 and q0q1 whose lines' closest points lie strictly
@@ -136,13 +98,13 @@ TEST(EdgeEntrance, AnEdgeAcrossAFaceAtTheOtherEdgeHasItsSecondCrossing) {
 		const double secondGap = skewDistance(apex, e4End, b0, b1);
 		ASSERT_LT(firstGap, secondGap);
 		ASSERT_LT(secondGap, d0);
-		for (const Matrix3& R : rotations(3)) {
+		for (const Matrix3& R : dda::testing::sceneRotations(kSeed, 3)) {
 			std::vector<Vector3> P, K;
 			for (const Vector3& x : pyramid) P.push_back(R * x);
 			for (const Vector3& x : knife) K.push_back(R * x);
-			const Block A = makeBlock(P), B = makeBlock(K);
-			const int e1 = A.edgeBetween(R * apex, R * e1End), e4 = A.edgeBetween(R * apex, R * e4End);
-			const int eb = B.edgeBetween(R * b0, R * b1);
+			const Block A = dda::testing::narrowBlock(P), B = dda::testing::narrowBlock(K);
+			const int e1 = edgeBetween(A, R * apex, R * e1End), e4 = edgeBetween(A, R * apex, R * e4End);
+			const int eb = edgeBetween(B, R * b0, R * b1);
 			ASSERT_GE(e1, 0);
 			ASSERT_GE(e4, 0);
 			ASSERT_GE(eb, 0);
@@ -150,7 +112,7 @@ TEST(EdgeEntrance, AnEdgeAcrossAFaceAtTheOtherEdgeHasItsSecondCrossing) {
 				const auto r = swap ? dda::detectPairContacts(B.geometry(), A.geometry(), s)
 				                    : dda::detectPairContacts(A.geometry(), B.geometry(), s);
 				ASSERT_TRUE(r.has_value());
-				const std::string what = describe(*r);
+				const std::string what = dda::testing::describePair(*r);
 				// The placement is the one meant: the entrance is the edge pair
 				// (e1, b), at the lines' distance.
 				ASSERT_EQ(r->entrance.kind, dda::EntranceFeature::EdgePair) << what;

@@ -16,6 +16,7 @@
 // Each placement is also turned by random rotations of the whole scene (seed
 // printed): the closed forms are invariant, the narrow phase must be too.
 // Units: m.
+#include "TestScenes.hpp"
 #include "dda/contact/PairDetection.hpp"
 #include "dda/geometry/ConvexPolyhedron.hpp"
 
@@ -82,17 +83,7 @@ std::vector<Vector3> boxPoints(const Vector3& lo, const Vector3& hi) {
 	return p;
 }
 
-// The identity, then `count` random rotations (seed kSeed, printed).
-std::vector<Matrix3> rotations(int count) {
-	std::vector<Matrix3> out{Matrix3::Identity()};
-	std::mt19937 rng(kSeed);
-	std::normal_distribution<double> normal(0.0, 1.0);
-	for (int k = 0; k < count; ++k) {
-		Eigen::Quaterniond q(normal(rng), normal(rng), normal(rng), normal(rng));
-		out.push_back(q.normalized().toRotationMatrix());
-	}
-	return out;
-}
+std::vector<Matrix3> rotations(int count) { return dda::testing::sceneRotations(kSeed, count); }
 
 DetectionSettings settings(double d0) {
 	DetectionSettings s;
@@ -102,17 +93,7 @@ DetectionSettings settings(double d0) {
 	return s;
 }
 
-// The pair's entrance and sub-contacts, for failure messages.
-std::string describe(const PairContacts& r) {
-	std::ostringstream out;
-	out << "entrance kind " << r.entrance.kind << " feature " << r.entrance.feature << ", separation "
-	    << r.separation << ", " << r.contacts.size() << " sub-contacts:";
-	for (const SubContact& c : r.contacts)
-		out << "\n  " << (c.kind == ContactKind::VertexFace ? "VF" : "EE") << " i=" << (c.firstIsA ? "A" : "B")
-		    << " features " << c.feature1 << "/" << c.feature2 << " gap " << c.gap << " normal "
-		    << c.normal.transpose() << " pointI " << c.pointI.transpose();
-	return out.str();
-}
+std::string describe(const PairContacts& r) { return dda::testing::describePair(r); }
 
 // A free cube (0.5 m) on a free slab of two parts, [0, 2] x [0, 1] x [0, 0.5]
 // and [2, 4] x [0, 1] x [0, 0.5], sharing the face x = 2 (internal to both),

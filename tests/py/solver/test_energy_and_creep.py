@@ -68,6 +68,34 @@ def translational(cubes):
     return energy, fastest
 
 
+def watch_drop(blocks, until, every):
+    """Runs a dropped pile (its engines set, not yet stepped) to `until` s, `every` steps at
+    a time, asserting at each sample: no block faster than a fall from the top of the pile
+    allows; damping and friction never negative; the account balanced (its sum minus
+    loads minus contactChanges) to 1e-3 of the largest change of any term. Returns the
+    largest rise of kinetic (translation) plus potential energy over its start (relative)
+    and the largest share of contactChanges in that change, with its time."""
+    O.run(1, True)
+    e0, _ = translational(blocks)
+    top = max(yade_dda.block(b).centroid[2] for b in blocks)
+    vmax = math.sqrt(2 * G * top)
+    a0 = yade_dda.stats()['energy']
+    worst, changes = 0.0, []
+    while O.time < until:
+        O.run(every, True)
+        e, fastest = translational(blocks)
+        assert math.isfinite(e) and fastest <= vmax, (O.time, fastest, vmax)
+        worst = max(worst, (e - e0) / abs(e0))
+        a = yade_dda.stats()['energy']
+        assert a['damping'] >= 0 and a['friction'] >= 0
+        scale = largest(a, a0)
+        drift = account(a) - account(a0) - (a['contactChanges'] - a0['contactChanges'])
+        assert abs(drift) <= 1e-3 * scale, (O.time, drift, scale)
+        changes.append(((a['contactChanges'] - a0['contactChanges']) / scale, O.time))
+    share, when = max(changes)
+    return worst, share, when
+
+
 @pytest.mark.parametrize('young', [1e5, 1e11])
 def test_dropped_pile_never_gains_energy(scene, young):
     """30 turned cubes dropped onto a floor, every setting at its default. Oracles:
@@ -84,25 +112,8 @@ def test_dropped_pile_never_gains_energy(scene, young):
     print('seed', SEED)
     cubes = pile(30, young, SEED, spacing=1.1)
     O.engines = [DDAIntegrator(gravity=(0, 0, -G), label='dda')]
-    O.run(1, True)
-    e0, _ = translational(cubes)
-    top = max(yade_dda.block(b).centroid[2] for b in cubes)
-    vmax = math.sqrt(2 * G * top)
-    a0 = yade_dda.stats()['energy']
-    worst, changes = 0.0, []
-    while O.time < 0.6:
-        O.run(20, True)
-        e, fastest = translational(cubes)
-        worst = max(worst, (e - e0) / e0)
-        assert fastest <= vmax, (O.time, fastest, vmax)
-        a = yade_dda.stats()['energy']
-        assert a['damping'] >= 0 and a['friction'] >= 0
-        scale = largest(a, a0)
-        drift = account(a) - account(a0) - (a['contactChanges'] - a0['contactChanges'])
-        assert abs(drift) <= 1e-3 * scale, (O.time, drift, scale)
-        changes.append(((a['contactChanges'] - a0['contactChanges']) / scale, O.time))
+    worst, share, when = watch_drop(cubes, 0.6, 20)
     assert worst <= 1e-3, worst
-    share, when = max(changes)
     if share > 1e-3 and young < 1e9:
         pytest.xfail('contact changes between steps added %.2g of the largest change by t = %.2f s (soft '
                      'penalty, deep overlaps; see the docstring)' % (share, when))
@@ -136,37 +147,18 @@ def test_random_hulls_dropped_into_a_box_keep_the_energy_account(scene, young):
     accepted; no block is faster than a fall from the top of the pile allows; kinetic
     plus potential energy never rises above its start by 0.1%; damping and friction
     never negative; the account balances to 1e-3 of the largest change. Contact changes
-    between steps should add no energy beyond 1e-3 of the largest change. Measured in
-    session 9 (seeds 1-8, 1.5 s): 0.2 to 2.5% at 1e9 Pa (0.46 at one seed) and 11 to 96% at
-    1e11 Pa. Two mechanisms, both measured contact by contact (doc/benchmarks.md,
-    "Energy of random hulls"): contacts kept from step to step whose next start, on the
-    moved geometry, is deeper than the step's linearised gap said (an edge-edge gap at a
-    small crossing angle is far from linear in the blocks' turns: 4.6 um at the start of
-    the next step where the step's model said 0.01 um), and crossings found only once
-    already deep (an edge entrance's second crossing of the same edge, 0.88 mm, 4.0e5 J
-    in one step). Reported as an expected failure while it is so, not hidden."""
+    between steps should add no energy beyond 1e-3 of the largest change. They do not
+    (bench/energy.py --hulls 8, session 9: up to 2.6% of it at 1e9 Pa, 10 to 77% at 1e11
+    Pa, seeds 1 to 8, 1 s), mostly from contacts kept from step to step whose next start,
+    on the moved geometry, is deeper than the step's linear gap said (an edge-edge gap at
+    a small crossing angle is far from linear in the blocks' turns: -10.7 um at the next
+    start where the step's model ended at -0.01 um); see doc/benchmarks.md, "Energy of
+    random hulls". Reported as an expected failure while it is so, not hidden."""
     print('seed', SEED)
-    cubes = hull_pile(27, young, SEED)
+    blocks = hull_pile(27, young, SEED)
     O.engines = [DDAIntegrator(gravity=(0, 0, -G), label='dda')]
-    O.run(1, True)
-    e0, _ = translational(cubes)
-    top = max(yade_dda.block(b).centroid[2] for b in cubes)
-    vmax = math.sqrt(2 * G * top)
-    a0 = yade_dda.stats()['energy']
-    worst, changes = 0.0, []
-    while O.time < 1.0:
-        O.run(25, True)
-        e, fastest = translational(cubes)
-        assert math.isfinite(e) and fastest <= vmax, (O.time, fastest, vmax)
-        worst = max(worst, (e - e0) / abs(e0))
-        a = yade_dda.stats()['energy']
-        assert a['damping'] >= 0 and a['friction'] >= 0
-        scale = largest(a, a0)
-        drift = account(a) - account(a0) - (a['contactChanges'] - a0['contactChanges'])
-        assert abs(drift) <= 1e-3 * scale, (O.time, drift, scale)
-        changes.append(((a['contactChanges'] - a0['contactChanges']) / scale, O.time))
+    worst, share, when = watch_drop(blocks, 1.0, 25)
     assert worst <= 1e-3, worst
-    share, when = max(changes)
     if share > 1e-3:
         pytest.xfail('contact changes between steps added %.2g of the largest change by t = %.2f s (random '
                      'hulls at %g Pa; see the docstring)' % (share, when, young))
