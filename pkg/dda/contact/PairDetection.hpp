@@ -40,6 +40,10 @@
 //          against its own entrance face of R instead, as the corners Q
 //          below are: its gap is then positive (outsideBeyondFaceEdge,
 //          SubContacts.cpp: no overlap at a corner outside R to push on);
+//          and so is a corner of I within d0 of F's plane that is not F's
+//          (its projection more than d0 from F, or deeper below the plane
+//          than the pair's penetration): a corner over a face of R beside
+//          F (session 9);
 //        - vertex-face G <- Q for each corner Q of F within d0 of I, G the
 //          face of I of largest signed distance of Q (Q's own entrance face),
 //          Q's projection within d0 of G, and Q not within

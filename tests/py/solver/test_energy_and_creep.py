@@ -148,7 +148,7 @@ def test_random_hulls_dropped_into_a_box_keep_the_energy_account(scene, young):
     plus potential energy never rises above its start by 0.1%; damping and friction
     never negative; the account balances to 1e-3 of the largest change. Contact changes
     between steps should add no energy beyond 1e-3 of the largest change. They do not
-    (bench/energy.py --hulls 8, session 9: up to 2.6% of it at 1e9 Pa, 10 to 77% at 1e11
+    (bench/energy.py --hulls 8, session 9: up to 1.1% of it at 1e9 Pa, 10 to 77% at 1e11
     Pa, seeds 1 to 8, 1 s), mostly from contacts kept from step to step whose next start,
     on the moved geometry, is deeper than the step's linear gap said (an edge-edge gap at
     a small crossing angle is far from linear in the blocks' turns: -10.7 um at the next
