@@ -446,6 +446,41 @@ bool outsideBeyondFaceEdge(const Prepared& owner, int f, const Prepared& block, 
 // two crossed logs a few mm apart have face axes a log's width deep, and
 // corners and edge crossings that deep below f are no contact of theirs (they
 // gave sub-contacts 1 m deep between logs that did not touch).
+//
+// The fold rule: a corner within d0 of f's plane that is not f's (its projection
+// more than d0 from f, or below f's plane deeper than the pair's
+// penetration; session 9) is measured against its own entrance face:
+// ownEntranceContact keeps it when its own
+// entrance face G of `owner` (the exposed face it lies farthest above)
+// has it within d0, no deeper than the penetration (`lowest`), its
+// projection within d0 of G: a corner within d0 of `owner`, where a
+// contact is due, over a face beside f. Every such corner is in this
+// band: f is exposed, so its distance from f's plane is at most its
+// distance from G's. Before, only the entrance face's search measured
+// the entering block's corners: a corner over the face beside the
+// entrance, as where a nearly planar side is split at a shallow fold
+// and a block rocks about the fold onto the other face, had no contact
+// until that face was the entrance, and it entered within a step
+// unopposed. Random hulls (27 in a box, session 9): at E = 1e11 Pa a
+// corner 0.65 m from the entrance's contacts, over a face 2.4 degrees
+// from the entrance face, 35 to 2.6 mm from it for 12 steps, found
+// first 0.34 mm deep (3.3e4 J in one step); at 1e9 Pa a corner 0.46 mm
+// deep after 4 such steps (690 J). Closed form:
+// tests/cpp/contact/test_fold_corner.cpp.
+// Energy: the rule only adds contacts, and closes, deepens or drops no
+// other. One added open (most: a corner comes within d0 before it
+// arrives) stores nothing, and open-close stops the corner at G; one
+// added at a negative gap is no deeper than the pair's penetration, its
+// first spring booked as a contact change, as any new contact's. A
+// corner below f's plane deeper than the penetration, left out before,
+// is kept against G only if G's gap is no deeper than that either.
+// Measured (bench/energy.py --hulls 8,
+// seeds 1-8, 1 s): the steps' gains 3.30e3 -> 2.29e3 J at 1e9 Pa and
+// 3.32e5 -> 2.86e5 J at 1e11 Pa; largest single step 690.8 -> 17.9 J
+// (1e9, seed 7) and 3.29e4 -> 1.48e3 J (1e11, seed 3); one seed's
+// largest rose, 2.49e3 -> 4.68e3 J (1e11, seed 4: a kept contact's
+// linearisation, on a changed trajectory; its net gains fell 0.70 ->
+// 0.61 of the scale).
 void faceEntranceContacts(const Prepared& owner, bool ownerIsA, int f, const Prepared& other, double depthBound,
                           double crossingBound, const DetectionSettings& settings, double sinTolerance, Scratch& s,
                           std::vector<SubContact>& out) {
@@ -480,40 +515,8 @@ void faceEntranceContacts(const Prepared& owner, bool ownerIsA, int f, const Pre
 	// A corner outside `owner` past f's edge is measured against its own
 	// face (outsideBeyondFaceEdge), after the crossings below: an open
 	// contact there must not stand for a crossing beside it.
-	//
-	// So is a corner within d0 of f's plane that is not f's: its projection
-	// more than d0 from f, or below f's plane deeper than the pair's
-	// penetration (session 9). ownEntranceContact keeps it when its own
-	// entrance face G of `owner` (the exposed face it lies farthest above)
-	// has it within d0, no deeper than the penetration (`lowest`), its
-	// projection within d0 of G: a corner within d0 of `owner`, where a
-	// contact is due, over a face beside f. Every such corner is in this
-	// band: f is exposed, so its distance from f's plane is at most its
-	// distance from G's. Before, only the entrance face's search measured
-	// the entering block's corners: a corner over the face beside the
-	// entrance, as where a nearly planar side is split at a shallow fold
-	// and a block rocks about the fold onto the other face, had no contact
-	// until that face was the entrance, and it entered within a step
-	// unopposed. Random hulls (27 in a box, session 9): at E = 1e11 Pa a
-	// corner 0.65 m from the entrance's contacts, over a face 2.4 degrees
-	// from the entrance face, 35 to 2.6 mm from it for 12 steps, found
-	// first 0.34 mm deep (3.3e4 J in one step); at 1e9 Pa a corner 0.46 mm
-	// deep after 4 such steps (690 J). Closed form:
-	// tests/cpp/contact/test_fold_corner.cpp.
-	// Energy: the rule only adds contacts, and closes, deepens or drops no
-	// other. One added open (most: a corner comes within d0 before it
-	// arrives) stores nothing, and open-close stops the corner at G; one
-	// added at a negative gap is no deeper than the pair's penetration, its
-	// first spring booked as a contact change, as any new contact's. A
-	// corner below f's plane deeper than the penetration, left out before,
-	// is kept against G only if G's gap is no deeper than that either.
-	// Measured (bench/energy.py --hulls 8,
-	// seeds 1-8, 1 s): the steps' gains 3.30e3 -> 2.29e3 J at 1e9 Pa and
-	// 3.32e5 -> 2.86e5 J at 1e11 Pa; largest single step 690.8 -> 17.9 J
-	// (1e9, seed 7) and 3.29e4 -> 1.48e3 J (1e11, seed 3); one seed's
-	// largest rose, 2.49e3 -> 4.68e3 J (1e11, seed 4: a kept contact's
-	// linearisation, on a changed trajectory; its net gains fell 0.70 ->
-	// 0.61 of the scale).
+	// So is a corner within d0 of f's plane that is not f's (the fold
+	// rule in the comment above the function).
 	std::vector<int>& used = s.used;
 	std::vector<int>& outside = s.outsideCorners;
 	used.clear();

@@ -22,6 +22,7 @@
 // by construction (computed here, independently of the narrow phase). The
 // scene is also turned by random rotations (seed printed) and given in both
 // orders. Units: m.
+#include "TestScenes.hpp"
 #include "dda/contact/PairDetection.hpp"
 #include "dda/geometry/ConvexPolyhedron.hpp"
 
@@ -30,8 +31,6 @@
 
 #include <cmath>
 #include <cstdio>
-#include <random>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -46,61 +45,33 @@ using Matrix3 = Eigen::Matrix3d;
 
 constexpr unsigned kSeed = 20261126;  // the random rotations'
 
-struct Block {
-	dda::ConvexPolyhedron shape;
-	std::vector<Vector3> vertices;
-	Vector3 centroid = Vector3::Zero();
-	dda::BlockGeometry geometry() const { return {&shape, &vertices, centroid, nullptr}; }
-	int vertexAt(const Vector3& p) const {
-		for (std::size_t v = 0; v < vertices.size(); ++v)
-			if ((vertices[v] - p).norm() < 1e-12) return static_cast<int>(v);
-		return -1;
-	}
-	// The face holding all of the given corners, -1 when none.
-	int faceWith(const std::vector<Vector3>& points) const {
-		for (std::size_t f = 0; f < shape.faces.size(); ++f) {
-			bool all = true;
-			for (const Vector3& p : points) {
-				bool on = false;
-				for (int v : shape.faces[f]) on = on || (vertices[v] - p).norm() < 1e-12;
-				all = all && on;
-			}
-			if (all) return static_cast<int>(f);
+using Block = dda::testing::NarrowBlock;
+
+int vertexAt(const Block& b, const Vector3& p) {
+	for (std::size_t v = 0; v < b.vertices.size(); ++v)
+		if ((b.vertices[v] - p).norm() < 1e-12) return static_cast<int>(v);
+	return -1;
+}
+
+// The face of `b` holding all of the given corners, -1 when none.
+int faceWith(const Block& b, const std::vector<Vector3>& points) {
+	for (std::size_t f = 0; f < b.shape.faces.size(); ++f) {
+		bool all = true;
+		for (const Vector3& p : points) {
+			bool on = false;
+			for (int v : b.shape.faces[f]) on = on || (b.vertices[v] - p).norm() < 1e-12;
+			all = all && on;
 		}
-		return -1;
+		if (all) return static_cast<int>(f);
 	}
-};
-
-Block makeBlock(const std::vector<Vector3>& points) {
-	Block b;
-	b.shape = dda::buildConvexPolyhedron(points);
-	b.vertices = b.shape.vertices;
-	for (const Vector3& p : points) b.centroid += p;
-	b.centroid /= static_cast<double>(points.size());
-	return b;
+	return -1;
 }
 
-std::vector<Matrix3> rotations(int count) {
-	std::vector<Matrix3> out{Matrix3::Identity()};
-	std::mt19937 rng(kSeed);
-	std::normal_distribution<double> normal(0.0, 1.0);
-	for (int k = 0; k < count; ++k) {
-		Eigen::Quaterniond q(normal(rng), normal(rng), normal(rng), normal(rng));
-		out.push_back(q.normalized().toRotationMatrix());
-	}
-	return out;
-}
+Block makeBlock(const std::vector<Vector3>& points) { return dda::testing::narrowBlock(points); }
 
-std::string describe(const PairContacts& r) {
-	std::ostringstream out;
-	out << "entrance kind " << r.entrance.kind << " feature " << r.entrance.feature << ", separation "
-	    << r.separation << ", " << r.contacts.size() << " sub-contacts:";
-	for (const SubContact& c : r.contacts)
-		out << "\n  " << (c.kind == ContactKind::VertexFace ? "VF" : "EE") << " i=" << (c.firstIsA ? "A" : "B")
-		    << " features " << c.feature1 << "/" << c.feature2 << " gap " << c.gap << " normal "
-		    << c.normal.transpose();
-	return out.str();
-}
+std::vector<Matrix3> rotations(int count) { return dda::testing::sceneRotations(kSeed, count); }
+
+std::string describe(const PairContacts& r) { return dda::testing::describePair(r); }
 
 // (s: the fold's slope [-]; L: P's distance past the ridge [m]; g: P's height
 // above F2 [m]; h1: Q's height above F1 [m]; xq: Q's distance before the
@@ -140,9 +111,9 @@ TEST(FoldCorner, ACornerOverTheFaceBesideTheEntranceHasItsContact) {
 			for (const Vector3& x : roof) Ar.push_back(R * x);
 			for (const Vector3& x : tetra) Br.push_back(R * x);
 			const Block A = makeBlock(Ar), B = makeBlock(Br);
-			const int f1 = A.faceWith({R * ridge0, R * ridge1, R * Vector3(-1, 1, 1 - k.s)});
-			const int f2 = A.faceWith({R * ridge0, R * ridge1, R * eave0, R * eave1});
-			const int p = B.vertexAt(R * P);
+			const int f1 = faceWith(A, {R * ridge0, R * ridge1, R * Vector3(-1, 1, 1 - k.s)});
+			const int f2 = faceWith(A, {R * ridge0, R * ridge1, R * eave0, R * eave1});
+			const int p = vertexAt(B, R * P);
 			ASSERT_GE(f1, 0);
 			ASSERT_GE(f2, 0);
 			ASSERT_GE(p, 0);
