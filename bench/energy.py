@@ -63,6 +63,11 @@ G = 9.81
 SEED = 20261125
 
 
+def account(e):
+    """The energy account's sum minus the loads [J] (conserved up to contactChanges)."""
+    return e['kinetic'] + e['gravity'] + e['strain'] + e['contact'] + e['friction'] + e['damping'] - e['loads']
+
+
 def small_pile(young, count):
     """The 30-cube pile of `make bench` (3 x 3 per layer, 0.1 m apart)."""
     rng = random.Random(SEED)
@@ -103,9 +108,6 @@ def run(young, duration, count=30, side=None, threads=0, every=10, progress=None
             if b not in landed and O.time > 0 and abs(v[2] + G * O.time) > 0.01 * G * O.time:
                 landed[b] = O.time
         return energy, fastest
-
-    def account(e):
-        return e['kinetic'] + e['gravity'] + e['strain'] + e['contact'] + e['friction'] + e['damping'] - e['loads']
 
     start, cpuStart = time.time(), time.process_time()
     O.step()  # synchronous: O.run(1, True) waits about 40 ms per call for YADE's thread
@@ -189,9 +191,6 @@ def run_hulls(young, seed, duration, threads=0):
 
     def kp(a):
         return a['kinetic'] + a['gravity']
-
-    def account(e):
-        return e['kinetic'] + e['gravity'] + e['strain'] + e['contact'] + e['friction'] + e['damping'] - e['loads']
 
     prev, gains, largest, largestAt, rise, steps = a0['contactChanges'], 0.0, 0.0, 0.0, 0.0, 1
     while O.time < duration:

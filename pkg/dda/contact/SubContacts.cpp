@@ -433,6 +433,23 @@ bool outsideBeyondFaceEdge(const Prepared& owner, int f, const Prepared& block, 
 	return beyond;
 }
 
+// The usable edges of face f of `owner` (edgeList order) into `out`.
+void edgesOfFace(const Prepared& owner, int f, std::vector<int>& out) {
+	out.clear();
+	for (int e : owner.edgeList) {
+		const auto& ef = owner.shape->edgeFaces[e];
+		if (ef[0] == f || ef[1] == f) out.push_back(e);
+	}
+}
+
+// Whether a point of sub-contact c lies within `merge` [m] of a point of the
+// edge entrance's crossing: the crossing's own contact.
+bool atCrossing(const SubContact& c, const SubContact& crossing, double merge) {
+	for (const Vector3* p : {&c.pointI, &c.pointJ})
+		if ((*p - crossing.pointI).norm() <= merge || (*p - crossing.pointJ).norm() <= merge) return true;
+	return false;
+}
+
 // Step 3 for a face entrance: face f of block `owner` (block j of every
 // vertex-face contact of the other block's corners) entered by block `other`.
 // `depthBound` is the pair's separation (<= 0 when they overlap) as step 3
@@ -558,11 +575,7 @@ void faceEntranceContacts(const Prepared& owner, bool ownerIsA, int f, const Pre
 	// crossings `crossingBound`, which near-parallel edge axes may raise).
 	const double deepest = std::min(crossingBound, 0.0) - settings.lengthTolerance;
 	std::vector<int>& faceEdges = s.faceEdges;
-	faceEdges.clear();
-	for (int e : owner.edgeList) {
-		const auto& ef = owner.shape->edgeFaces[e];
-		if (ef[0] == f || ef[1] == f) faceEdges.push_back(e);
-	}
+	edgesOfFace(owner, f, faceEdges);
 	// A crossing beside a vertex contact found above is that corner's contact
 	// (two squares offset by a little drift cross each other's edges right
 	// beside their corners); a crossing with no vertex contact near it stays.
@@ -621,9 +634,7 @@ void otherFeaturesOfEdgeEntrance(const Prepared& a, const Prepared& b, const Ent
 			const int edgeA = c.firstIsA ? c.feature1 : c.feature2, edgeB = c.firstIsA ? c.feature2 : c.feature1;
 			if (edgeA == crossing.feature1 && edgeB == crossing.feature2) return true;
 		}
-		for (const Vector3* p : {&c.pointI, &c.pointJ})
-			if ((*p - crossing.pointI).norm() <= merge || (*p - crossing.pointJ).norm() <= merge) return true;
-		return false;
+		return atCrossing(c, crossing, merge);
 	};
 	out.erase(std::remove_if(out.begin() + static_cast<std::ptrdiff_t>(first), out.end(), sameAsCrossing), out.end());
 }
@@ -648,7 +659,7 @@ void otherFeaturesOfEdgeEntrance(const Prepared& a, const Prepared& b, const Ent
 // deeper than the pair's penetration (its spring is booked as a contact
 // change); none is closed, deepened or dropped by the rule.
 void crossingsAcrossEntranceFaces(const Prepared& a, const Prepared& b, int edgeA, int edgeB, double crossingBound,
-                                  const DetectionSettings& settings, double sinTolerance,
+                                  const DetectionSettings& settings, double sinTolerance, Scratch& s,
                                   std::vector<SubContact>& out) {
 	const SubContact crossing = out.front();
 	const double reach = settings.contactDistance + settings.lengthTolerance;
@@ -663,9 +674,7 @@ void crossingsAcrossEntranceFaces(const Prepared& a, const Prepared& b, int edge
 			    ((o.feature1 == c.feature1 && o.feature2 == c.feature2 && o.firstIsA == c.firstIsA) ||
 			     (o.feature1 == c.feature2 && o.feature2 == c.feature1 && o.firstIsA != c.firstIsA)))
 				return true;
-		for (const Vector3* p : {&c.pointI, &c.pointJ})
-			if ((*p - crossing.pointI).norm() <= merge || (*p - crossing.pointJ).norm() <= merge) return true;
-		return besideVertexContact(c, out, merge);
+		return atCrossing(c, crossing, merge) || besideVertexContact(c, out, merge);
 	};
 	for (int side = 0; side < 2; ++side) {
 		// The faces of `owner` at its entrance edge, crossed by the other block's entrance edge.
@@ -676,10 +685,9 @@ void crossingsAcrossEntranceFaces(const Prepared& a, const Prepared& b, int edge
 			if (f < 0 || owner.internal(f)) continue;
 			ensurePlane(owner, f);
 			limits.direction = &owner.faces[f].normal;
-			for (int g : owner.edgeList) {
+			edgesOfFace(owner, f, s.faceEdges);
+			for (int g : s.faceEdges) {
 				if (g == ownEdge) continue;
-				const auto& gf = owner.shape->edgeFaces[g];
-				if (gf[0] != f && gf[1] != f) continue;
 				++*owner.tests;
 				const std::optional<SubContact> c =
 				    edgeEdgeContact(side != 0, other, otherEdge, owner, g, settings, sinTolerance, limits);
@@ -968,7 +976,7 @@ void findSubContacts(const Prepared& a, const Prepared& b, const std::vector<Fac
 			otherFeaturesOfEdgeEntrance(a, b, chooseFace(faces, a, b, tol, previous).feature, depthBound,
 			                            crossingBound, settings, sinTolerance, s, out.contacts);
 			crossingsAcrossEntranceFaces(a, b, entrance.feature.feature, entrance.feature.other, crossingBound, settings,
-			                             sinTolerance, out.contacts);
+			                             sinTolerance, s, out.contacts);
 		} else {
 			// The edges do not cross strictly inside (a corner meets an edge),
 			// or their crossing is deeper than the bound: the best face is the
