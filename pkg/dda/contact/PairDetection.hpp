@@ -197,6 +197,12 @@ struct BlockGeometry {
 	// Optional: the block's planes for its current corners (BlockPlanes); when
 	// absent the narrow phase builds what it needs per call.
 	const BlockPlanes* planes = nullptr;
+	// Optional, per face (with internalFaces): how far past an internal face's
+	// plane its flush neighbour surely reaches over the whole face [m]
+	// (markInternalFaces' cover depth; 0 where not known). A corner of the
+	// other block just past such a face, inside that reach, is inside the
+	// fixed mass, at the seam of the two blocks (ownEntranceContact).
+	const std::vector<double>* coverDepths = nullptr;
 };
 
 // Which feature is the pair's entrance feature (step 2).

@@ -85,6 +85,7 @@ struct Prepared {
 	int faceTotal = 0;
 	Vector3 lower = Vector3::Zero(), upper = Vector3::Zero();  // bounding box [m]
 	const std::vector<char>* internalFaces = nullptr;
+	const std::vector<double>* coverDepths = nullptr;  // BlockGeometry::coverDepths
 	// The sub-units the narrow phase may use (all, or those a broad phase
 	// linked to the pair), and per corner whether it is one of them.
 	Indices vertexList, edgeList, faceList;
@@ -96,6 +97,8 @@ struct Prepared {
 	// A face covered by a coplanar face of a neighbouring fixed block: never an
 	// entrance, and its edges give no edge axes.
 	bool internal(int f) const { return internalFaces && (*internalFaces)[f]; }
+	// How far past internal face f its flush neighbour surely reaches [m] (0: unknown).
+	double coverDepth(int f) const { return coverDepths ? (*coverDepths)[f] : 0.0; }
 	bool internalEdge(int e) const {
 		return internalFaces && ((*internalFaces)[shape->edgeFaces[e][0]] || (*internalFaces)[shape->edgeFaces[e][1]]);
 	}

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace dda {
 
@@ -20,9 +21,30 @@ bool insideFacePolygon(const Vector3& x, const std::vector<Vector3>& vertices, c
 }
 
 namespace {
-// Marks the faces of bodies a and b that cover each other (see markInternalFaces).
+// The shortest chord [m] of convex body `cover` along unit direction d from
+// the corners of `face` (corners of `vertices` on cover's surface, on the face
+// that covers it): how far each reaches into `cover` before it leaves through
+// a face plane that d points out of, the least over the corners (>= 0).
+double coverDepth(const std::vector<Vector3>& vertices, const std::vector<int>& face, const PlacedPolyhedron& cover,
+                  const Vector3& d) {
+	const std::vector<Vector3>& v = *cover.vertices;
+	double depth = std::numeric_limits<double>::infinity();
+	for (int c : face) {
+		for (const std::vector<int>& k : cover.shape->faces) {
+			const Vector3 n = faceNormal(v, k);
+			const double along = n.dot(d);
+			if (!(along > 0)) continue;
+			depth = std::min(depth, std::max(0.0, n.dot(v[k[0]] - vertices[c])) / along);
+		}
+	}
+	return std::isfinite(depth) ? depth : 0.0;
+}
+
+// Marks the faces of bodies a and b that cover each other (see markInternalFaces),
+// and with depth vectors the covers' depths.
 void markCoveredFaces(const PlacedPolyhedron& A, const PlacedPolyhedron& B, double tolerance,
-                      double parallelAngleTolerance, std::vector<char>& internalA, std::vector<char>& internalB) {
+                      double parallelAngleTolerance, std::vector<char>& internalA, std::vector<char>& internalB,
+                      std::vector<double>* depthA, std::vector<double>* depthB) {
 	const std::vector<Vector3>& verticesA = *A.vertices;
 	const std::vector<Vector3>& verticesB = *B.vertices;
 	for (std::size_t f = 0; f < A.shape->faces.size(); ++f) {
@@ -41,20 +63,27 @@ void markCoveredFaces(const PlacedPolyhedron& A, const PlacedPolyhedron& B, doub
 				gCovered = gCovered && insideFacePolygon(verticesB[v], verticesA, A.shape->faces[f], nf, tolerance);
 			if (fCovered) internalA[f] = 1;
 			if (gCovered) internalB[g] = 1;
+			if (fCovered && depthA)
+				(*depthA)[f] = std::max((*depthA)[f], coverDepth(verticesA, A.shape->faces[f], B, nf));
+			if (gCovered && depthB)
+				(*depthB)[g] = std::max((*depthB)[g], coverDepth(verticesB, B.shape->faces[g], A, ng));
 		}
 	}
 }
 }  // namespace
 
 void markInternalFaces(const std::vector<PlacedPolyhedron>& bodies, double relativeLengthTolerance,
-                       double parallelAngleTolerance, std::vector<std::vector<char>>& internal) {
+                       double parallelAngleTolerance, std::vector<std::vector<char>>& internal,
+                       std::vector<std::vector<double>>* coverDepths) {
 	internal.assign(bodies.size(), {});
+	if (coverDepths) coverDepths->assign(bodies.size(), {});
 	std::vector<int> given;
 	std::vector<Eigen::AlignedBox3d> boxes(bodies.size());
 	for (std::size_t b = 0; b < bodies.size(); ++b) {
 		if (!bodies[b].shape) continue;
 		given.push_back(static_cast<int>(b));
 		internal[b].assign(bodies[b].shape->faces.size(), 0);
+		if (coverDepths) (*coverDepths)[b].assign(bodies[b].shape->faces.size(), 0.0);
 		for (const Vector3& x : *bodies[b].vertices) boxes[b].extend(x);
 	}
 	std::sort(given.begin(), given.end(), [&](int a, int b) { return boxes[a].min().x() < boxes[b].min().x(); });
@@ -69,7 +98,8 @@ void markInternalFaces(const std::vector<PlacedPolyhedron>& bodies, double relat
 			grown.min().array() -= tolerance;
 			grown.max().array() += tolerance;
 			if (!grown.intersects(boxes[b])) continue;
-			markCoveredFaces(bodies[a], bodies[b], tolerance, parallelAngleTolerance, internal[a], internal[b]);
+			markCoveredFaces(bodies[a], bodies[b], tolerance, parallelAngleTolerance, internal[a], internal[b],
+			                 coverDepths ? &(*coverDepths)[a] : nullptr, coverDepths ? &(*coverDepths)[b] : nullptr);
 		}
 	}
 }

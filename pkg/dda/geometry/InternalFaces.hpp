@@ -30,7 +30,20 @@ bool insideFacePolygon(const Vector3& x, const std::vector<Vector3>& vertices, c
 // parallelAngleTolerance [rad] of opposite, coplanar and covering within
 // relativeLengthTolerance x the larger bounding-box diagonal [m]. Pairs are
 // found by sorting boxes along x.
+//
+// With `coverDepths`, also per face the cover's depth [m]: for a covered
+// face, how far past its plane (along its outward normal) the covering
+// body surely reaches over the whole face (0 for a face not covered). It
+// is the shortest chord of the covering body along that normal from the
+// face's corners: the chord from a point of the covering face is a concave
+// function of the point (the covering body is convex), so over the face it
+// is least at a corner, and every point that projects into the face no
+// farther past it than the depth lies in the covering body. The largest
+// over the bodies covering the face. A covered face whose cover thins to
+// nothing at one of its corners (two parts of a concave block meeting at a
+// ridge) has depth 0.
 void markInternalFaces(const std::vector<PlacedPolyhedron>& bodies, double relativeLengthTolerance,
-                       double parallelAngleTolerance, std::vector<std::vector<char>>& internal);
+                       double parallelAngleTolerance, std::vector<std::vector<char>>& internal,
+                       std::vector<std::vector<double>>* coverDepths = nullptr);
 
 }  // namespace dda

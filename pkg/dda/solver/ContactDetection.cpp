@@ -98,7 +98,12 @@ void ContactDetection::detect(const std::vector<Block>& blocks, Collider& collid
 			for (int b = 0; b < blockCount; ++b) diagonals_[b] = boundingDiagonal(blocks[b]);
 		}
 	}
-	if (internalFacesBlocks_ != blockCount) updateInternalFaces(blocks);
+	if (internalFacesBlocks_ != blockCount) {
+		updateInternalFaces(blocks);
+	} else if (coverDepthsBlocks_ != blockCount) {  // after a load: the flags came with the state
+		std::vector<std::vector<char>> flags;
+		markFixedBlocks(blocks, flags);
+	}
 	const int pairCount = static_cast<int>(pairs_.size());
 	// Threads by the step's pair count, not the chunk's: a small scene stays
 	// serial, and a large one's chunks (all but perhaps its last) are large.
@@ -135,11 +140,16 @@ void ContactDetection::findPairs(const std::vector<Block>& blocks, Collider& col
 // Fixed blocks never move, and the parts of a concave block move by one
 // affine map (the faces they share stay shared), so this runs only when
 // blocks are added.
-void ContactDetection::updateInternalFaces(const std::vector<Block>& blocks) {
+void ContactDetection::markFixedBlocks(const std::vector<Block>& blocks, std::vector<std::vector<char>>& flags) {
 	std::vector<PlacedPolyhedron> fixed(blocks.size());
 	for (std::size_t b = 0; b < blocks.size(); ++b)
 		if (blocks[b].fixed) fixed[b] = PlacedPolyhedron{blocks[b].shape.get(), &blocks[b].vertices};
-	markInternalFaces(fixed, kDefaultRelativeLengthTolerance, kDefaultParallelAngleTolerance, internalFaces_);
+	markInternalFaces(fixed, kDefaultRelativeLengthTolerance, kDefaultParallelAngleTolerance, flags, &coverDepths_);
+	coverDepthsBlocks_ = static_cast<int>(blocks.size());
+}
+
+void ContactDetection::updateInternalFaces(const std::vector<Block>& blocks) {
+	markFixedBlocks(blocks, internalFaces_);
 	// The faces the parts of a moving concave block share (a fixed one's are
 	// marked above with every fixed block).
 	std::vector<std::vector<char>> partFaces;
@@ -253,9 +263,11 @@ void ContactDetection::detectChunk(Step& step, int begin, int count, int chunk) 
 			    pairDetectionSettings(diagonals_[a], diagonals_[b], stats.contactDistance, stats.allowedDisplacement);
 			const std::vector<char>* internalA = internalFaces_[a].empty() ? nullptr : &internalFaces_[a];
 			const std::vector<char>* internalB = internalFaces_[b].empty() ? nullptr : &internalFaces_[b];
+			const std::vector<double>* coverA = coverDepths_[a].empty() ? nullptr : &coverDepths_[a];
+			const std::vector<double>* coverB = coverDepths_[b].empty() ? nullptr : &coverDepths_[b];
 			pairFound_[q] = detectPairContacts(
-			    BlockGeometry{A.shape.get(), &A.vertices, interiorPoint(A), internalA, &planes_[planeSlot_[a]]},
-			    BlockGeometry{B.shape.get(), &B.vertices, interiorPoint(B), internalB, &planes_[planeSlot_[b]]},
+			    BlockGeometry{A.shape.get(), &A.vertices, interiorPoint(A), internalA, &planes_[planeSlot_[a]], coverA},
+			    BlockGeometry{B.shape.get(), &B.vertices, interiorPoint(B), internalB, &planes_[planeSlot_[b]], coverB},
 			    detection, pairResults_[q], step.store.previousEntrance(a, b), step.collider.linked(begin + q),
 			    &pairWork_[q]);
 			// The contact area feeds only the bond strengths (prepareContact: the
