@@ -175,16 +175,17 @@ def run(young, duration, count=30, side=None, threads=0, every=10, progress=None
     return row
 
 
-def run_hulls(young, seed, duration, threads=0):
+def run_hulls(young, seed, duration, threads=0, dt=None):
     """The random-hull pile of test_energy_and_creep.py (27 hulls of 4 to 12 random points
     dropped into a fixed box, that test's builder) for `duration` s, every step: the
     contactChanges between steps (net, summed gains, the largest single step and when),
     over the largest change of any account term; the account's drift; kinetic plus
-    potential energy's largest rise; steps and CPU seconds."""
+    potential energy's largest rise; steps and CPU seconds. `dt` [s]: DDAIntegrator.dt
+    (the largest step; None: its default)."""
     from test_energy_and_creep import hull_pile
     O.reset()
     blocks = hull_pile(27, young, seed)
-    O.engines = [DDAIntegrator(gravity=(0, 0, -G), threads=threads, label='dda')]
+    O.engines = [DDAIntegrator(gravity=(0, 0, -G), threads=threads, label='dda', **({} if dt is None else dict(dt=dt)))]
     cpuStart = time.process_time()
     O.step()
     a0 = dict(yade_dda.stats()['energy'])
@@ -207,7 +208,7 @@ def run_hulls(young, seed, duration, threads=0):
     a = yade_dda.stats()['energy']
     scale = max(abs(a[k] - a0[k]) for k in a)
     drift = account(a) - account(a0) - (a['contactChanges'] - a0['contactChanges'])
-    return dict(young=young, seed=seed, blocks=len(blocks), time=O.time, steps=steps, scale=scale,
+    return dict(young=young, seed=seed, dt=O.engines[0].dt, blocks=len(blocks), time=O.time, steps=steps, scale=scale,
                 contactChanges=(a['contactChanges'] - a0['contactChanges']) / scale, gains=gains / scale,
                 largestStepGain=largest / scale, largestStepGainJ=largest, largestAt=largestAt,
                 accountDrift=drift / scale, kineticPlusPotentialRise=rise / scale,
@@ -230,21 +231,23 @@ def main():
                         help='with --count/--pile200: stop a run once gainFull is above this (blown up)')
     parser.add_argument('--hulls', type=int, default=None, metavar='N',
                         help='the random-hull pile of test_energy_and_creep.py, seeds 1..N (default E: 1e9 1e11)')
+    parser.add_argument('--dts', type=float, nargs='+', default=[None],
+                        help='with --hulls: DDAIntegrator.dt values to run each seed at [s] (default: its default)')
     parser.add_argument('--out', default=os.path.join(os.path.dirname(os.path.abspath(__file__)), 'out'))
     args = parser.parse_args()
     if args.hulls:
         youngs = args.youngs if '--youngs' in sys.argv else [1e9, 1e11]
-        rows = [run_hulls(E, seed, args.time or 1.0, args.threads) for E in youngs
+        rows = [run_hulls(E, seed, args.time or 1.0, args.threads, dt) for E in youngs for dt in args.dts
                 for seed in range(1, args.hulls + 1)]
         os.makedirs(args.out, exist_ok=True)
         with open(os.path.join(args.out, 'energy_hulls.json'), 'w') as f:
             json.dump(dict(rows=rows), f, indent=1)
-        print('%8s %4s %6s %10s %10s %12s %8s %9s %9s' % ('E [Pa]', 'seed', 'steps', 'changes', 'gains',
-                                                         'largest step', 'at [s]', 'drift', 'rise'))
+        print('%8s %8s %4s %6s %10s %10s %12s %8s %9s %9s %7s' % (
+            'E [Pa]', 'dt [s]', 'seed', 'steps', 'changes', 'gains', 'largest step', 'at [s]', 'drift', 'rise', 'CPU s'))
         for r in rows:
-            print('%8.0e %4d %6d %10.2e %10.2e %12.2e %8.3f %9.1e %9.1e' % (
-                r['young'], r['seed'], r['steps'], r['contactChanges'], r['gains'], r['largestStepGain'],
-                r['largestAt'], r['accountDrift'], r['kineticPlusPotentialRise']))
+            print('%8.0e %8.1e %4d %6d %10.2e %10.2e %12.2e %8.3f %9.1e %9.1e %7.1f' % (
+                r['young'], r['dt'], r['seed'], r['steps'], r['contactChanges'], r['gains'], r['largestStepGain'],
+                r['largestAt'], r['accountDrift'], r['kineticPlusPotentialRise'], r['cpuSeconds']))
         return
     if args.pile200:
         args.count, args.side = 200, 5
