@@ -54,6 +54,8 @@ struct Scratch {
 	std::vector<int> faceRows, faceSigns;    // per face of A: its row of Gauss-map signs per edge of B
 	std::vector<char> faceMark;
 	std::vector<Vector3> pointsA, pointsB;
+	std::vector<unsigned char> cornerSides;  // featureOf: per corner, a point's sides of it
+	std::vector<char> farEdges;              // featureOf: edges with a point beyond their box
 	std::vector<int> identity;  // 0, 1, 2, ...: "every sub-unit"
 	std::vector<char> vertexLinked[2];
 };

@@ -13,6 +13,36 @@ struct Feature {
 	int index = -1;  // corner (Vertex) or edge (Edge)
 };
 
+// Which edges of `block` have a point outside their bounding box widened by
+// `margin` [m] in some coordinate (s.farEdges[e] = 1): featureOf's edge test,
+// from the corners' sides. Rounding is monotone, so fl(max(p, q) + margin) =
+// max(fl(p + margin), fl(q + margin)) and fl(min(p, q) - margin) = min(fl(p -
+// margin), fl(q - margin)): x is above edge pq's widened box in coordinate k
+// exactly when above both corners' widened coordinates, and below exactly when
+// below both (a NaN compares false either way). So an edge's sides are the AND
+// of its corners' (bit k: above in coordinate k, bit 3 + k: below), computed
+// once per corner and point instead of per edge and point: the same
+// comparisons of the same doubles as the box test of each edge.
+void markFarEdges(const Prepared& block, const std::vector<Vector3>& points, double margin, Scratch& s) {
+	std::vector<unsigned char>& sides = s.cornerSides;
+	std::vector<char>& far = s.farEdges;
+	sides.resize(block.cornerCount());
+	far.assign(block.edgeCount(), 0);
+	const auto& edges = block.shape->edges;
+	for (const Vector3& x : points) {
+		for (int v = 0; v < block.cornerCount(); ++v) {
+			const Vector3& c = block.corner(v);
+			unsigned bits = 0;
+			for (int k = 0; k < 3; ++k) {
+				bits |= static_cast<unsigned>(x(k) > c(k) + margin) << k;
+				bits |= static_cast<unsigned>(x(k) < c(k) - margin) << (3 + k);
+			}
+			sides[v] = static_cast<unsigned char>(bits);
+		}
+		for (int e = 0; e < block.edgeCount(); ++e) far[e] |= (sides[edges[e][0]] & sides[edges[e][1]]) != 0;
+	}
+}
+
 // The smallest feature of `block` within `tolerance` [m] of all the points: one
 // corner, else one edge, else a face.
 //
@@ -22,8 +52,8 @@ struct Feature {
 // vector to within 2 DBL_EPSILON relative, and a computed segment distance is
 // at least x's distance from the segment's bounding box along an axis, to
 // within a few DBL_EPSILON of the coordinates (the closest point is rounded);
-// the margins 1e-12 cover both.
-Feature featureOf(const Prepared& block, const std::vector<Vector3>& points, double tolerance) {
+// the margins 1e-12 cover both. The edges' box tests are markFarEdges'.
+Feature featureOf(const Prepared& block, const std::vector<Vector3>& points, double tolerance, Scratch& s) {
 	Feature out;
 	if (points.empty()) return out;
 	const double reach = tolerance * (1 + 1e-12);
@@ -53,18 +83,11 @@ Feature featureOf(const Prepared& block, const std::vector<Vector3>& points, dou
 	for (int v = 0; v < block.cornerCount(); ++v) largest = std::max(largest, block.corner(v).cwiseAbs().maxCoeff());
 	const double margin = reach + 3e-12 * largest;
 	double bestEdge = std::numeric_limits<double>::infinity();
+	markFarEdges(block, points, margin, s);
 	for (int e = 0; e < block.edgeCount(); ++e) {
+		if (s.farEdges[e]) continue;
 		const Vector3& p = block.edgeStart(e);
 		const Vector3& q = block.edgeEnd(e);
-		const Vector3 lower = p.cwiseMin(q).array() - margin, upper = p.cwiseMax(q).array() + margin;
-		bool far = false;
-		for (const Vector3& x : points) {
-			if ((x.array() > upper.array()).any() || (x.array() < lower.array()).any()) {
-				far = true;
-				break;
-			}
-		}
-		if (far) continue;
 		double worst = 0;
 		for (const Vector3& x : points) worst = std::max(worst, segmentDistance(x, p, q));
 		if (worst <= tolerance && worst < bestEdge) {
@@ -114,7 +137,7 @@ ContactType classifyPair(const Prepared& a, const Prepared& b, const PairContact
 		supportCorners(a, pair.normal, featureTolerance, pointsA);
 		supportCorners(b, -pair.normal, featureTolerance, pointsB);
 	}
-	return structuralType(a, featureOf(a, pointsA, featureTolerance), b, featureOf(b, pointsB, featureTolerance),
+	return structuralType(a, featureOf(a, pointsA, featureTolerance, s), b, featureOf(b, pointsB, featureTolerance, s),
 	                      sinTolerance);
 }
 

@@ -173,14 +173,12 @@ std::optional<SubContact> edgeEdgeContact(bool firstIsA, const Prepared& blockI,
 	const double crossNorm = cross.norm();
 	if (parallelDirections(da, db, cross, crossNorm, la, lb, sinTolerance)) return std::nullopt;
 	const double tol = settings.lengthTolerance;
-	{
-		const double nn = crossNorm * crossNorm;
-		const double sLine = sNumerator / nn;
-		const double tLine = tNumerator / nn;
-		if (!(sLine >= 0 && sLine <= 1 && tLine >= 0 && tLine <= 1)) return std::nullopt;
-		if (sLine * la <= tol || (1 - sLine) * la <= tol || tLine * lb <= tol || (1 - tLine) * lb <= tol)
-			return std::nullopt;
-	}
+	const double nn = crossNorm * crossNorm;
+	const double sLine = sNumerator / nn;
+	const double tLine = tNumerator / nn;
+	if (!(sLine >= 0 && sLine <= 1 && tLine >= 0 && tLine <= 1)) return std::nullopt;
+	if (sLine * la <= tol || (1 - sLine) * la <= tol || tLine * lb <= tol || (1 - tLine) * lb <= tol)
+		return std::nullopt;
 	{
 		// The gap limits, on the distance of the two lines before the stencil:
 		// the stencil's |gap| is |Delta| / S with S = crossNorm (the same
@@ -208,14 +206,32 @@ std::optional<SubContact> edgeEdgeContact(bool firstIsA, const Prepared& blockI,
 	// The stencil's n = -sigma (a x b)/|a x b| points from i to j.
 	c.normal = c.stencil.sigma * (cross / crossNorm);  // da.cross(db).normalized(), as in edgeAxis
 	if (limits.direction && c.normal.dot(*limits.direction) < limits.minCosine) return std::nullopt;
-	const EdgeEdgeResult r =
-	    edgeEdgeDistance(p1, p2, p3, p4, reference, settings.lengthTolerance, settings.angleTolerance);
-	if (r.parallel || !r.interior) return std::nullopt;
-	if (r.s * la <= tol || (1 - r.s) * la <= tol || r.t * lb <= tol || (1 - r.t) * lb <= tol) return std::nullopt;
 	c.kind = ContactKind::EdgeEdge;
 	c.firstIsA = firstIsA;
 	c.feature1 = e1;
 	c.feature2 = e2;
+	// The closest points, as edgeEdgeDistance(p1, p2, p3, p4, reference, tol,
+	// settings.angleTolerance) gives them, without calling it: it computes a =
+	// da, b = db, w, la, lb, cross, crossNorm and (w x b) . cross, (w x a) .
+	// cross by the expressions above, so its sLine, tLine are these. Its
+	// `parallel` is la == 0 || lb == 0 || crossNorm <= sin(angleTolerance) la
+	// lb, and sinTolerance is that sine (detectPairContacts computes it once
+	// for every caller): false when la > 0, lb > 0 and crossNorm >
+	// sinTolerance la lb (a NaN product fails the test). Its `interior` holds
+	// for sLine, tLine in [0, 1] (checked above) and tol >= 0 (its tolerances
+	// tol / la, tol / lb are >= 0 or +inf), and it then returns s = sLine, t =
+	// tLine and the points p1 + s da, p3 + t db; its endpoint test on s, t is
+	// the one above. Otherwise (never for valid settings and corners) it is
+	// called as before.
+	if (la > 0 && lb > 0 && crossNorm > sinTolerance * la * lb && tol >= 0) {
+		c.pointI = p1 + sLine * da;
+		c.pointJ = p3 + tLine * db;
+		return c;
+	}
+	const EdgeEdgeResult r =
+	    edgeEdgeDistance(p1, p2, p3, p4, reference, settings.lengthTolerance, settings.angleTolerance);
+	if (r.parallel || !r.interior) return std::nullopt;
+	if (r.s * la <= tol || (1 - r.s) * la <= tol || r.t * lb <= tol || (1 - r.t) * lb <= tol) return std::nullopt;
 	c.pointI = r.closestI;
 	c.pointJ = r.closestJ;
 	return c;
