@@ -463,6 +463,12 @@ bool outsideBeyondFaceEdge(const Prepared& owner, int f, const Prepared& block, 
 // as any new contact's (such a pair then has a sub-contact pushing it apart,
 // so nearParallelEdgeContact, made only when none does, is not: a contact
 // not made, a spring that leaves as a loss if it was there).
+// Measured: the coverage oracle's 48 scenes (8 seeds) unchanged (steps'
+// gains 1.372e7 J, largest 1.009e7 J, before and after); random hulls
+// (bench/energy.py --hulls 8, 1e9 and 1e11 Pa, 1 s) bit-identical energy
+// accounts: the rule added 0 to 216 contact-steps per run (0.2 %), all
+// open while there, none closed; the slender deposit's 1,214 sub-contacts
+// the same (bench/narrow_phase.cpp).
 void ownerCornersBesideFace(const Prepared& owner, bool ownerIsA, int f, const Prepared& other, double above,
                             double reach, double tolerance, double lowest, double merge, std::vector<SubContact>& out) {
 	const std::vector<int>& face = owner.shape->faces[f];
