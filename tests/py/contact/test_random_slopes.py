@@ -18,20 +18,21 @@ Oracles, per case, over 1 s:
   uniform strain under the contact forces' first moment: closed forms of the drawn
   geometry, 1e-6 m-ish); between 0.5 s and 1 s it moves less than that bound too, and
   its speed at 1 s is below the bound over 0.5 s (a steady creep at that speed would
-  exceed the bound in the last half second); it does not turn by more than the bound
-  over the footprint's narrowest width; the contact forces on it balance its weight
-  (1e-3 of m g).
+  exceed the bound in the last half second); the contact forces on it balance its
+  weight (1e-3 of m g).
 - FS in 0.2..0.8 ('slide'): the prism slides down the dip direction with
   a = g (sin theta - tan(phi) cos theta): the velocity gain along the dip from 0.3 s to
   1 s is a x 0.7 s within 1e-3, the displacement a t^2 / 2 within 1e-3; across the
-  dip and along the normal it moves less than the settlement bound, and turns less
-  than the bound over the narrowest width (a translating block feels no moment: the
-  contact force passes through the centroid); every closed contact is sliding (every
+  dip and along the normal it moves less than the settlement bound (a translating block
+  feels no moment: the contact force passes through the centroid); every closed contact
+  is sliding (every
   point of the base slips at the block's velocity); the normal forces sum to
   m g cos(theta) and the friction to tan(phi) times that (1e-3 of m g); friction
   dissipates tan(phi) m g cos(theta) x the distance slid (1e-3), and the kinetic
   energy is m (a t)^2 / 2 (1e-3).
-- Both: the energy account (stats()['energy']) balances: its terms' change minus the
+- Both: it tilts by no more than the settlement bound over the footprint's narrowest
+  width, and spins about the normal by no more than the stored elastic energy allows
+  (check_rotation). The energy account (stats()['energy']) balances: its terms' change minus the
   loads, less what contact changes between steps add (contactChanges), stays within
   1e-6 of the scale (the largest change of any term, or, at rest, where the settling
   happened in the first step, m g times the settlement bound); contactChanges adds no
@@ -41,8 +42,15 @@ Oracles, per case, over 1 s:
 The tolerances are not fitted to DDA: 1e-3 on a constant acceleration is far above
 what an exact-for-constant-acceleration scheme with stiff penalty springs leaves and
 far below what a wrong friction law gives (a 1% error in tan(phi) changes a by
-FS / (1 - FS) %, at least 0.25 %). Default run: SEEDS (two regimes each, about 20 s);
-`-m slow` sweeps SLOW_SEEDS.
+FS / (1 - FS) %, at least 0.25 %). Default run: SEEDS (two regimes each, about 25 s);
+`-m slow` sweeps SLOW_SEEDS (about 3 minutes).
+
+What the sweep found. Held prisms rang after a start-up lurch (seeds 11, 33): start from
+rest left shear springs beyond Coulomb's limit (ringing_at_rest says how), fixed by letting
+the settling end with the true friction (World::admitFriction). One slide stalls (seed 51):
+a step accepted with its friction limits unsettled tips the prism into rocking
+(stalled_slide); that case is an expected failure, recognised by its mechanism and
+reported with its numbers, not by its seed.
 """
 import math
 
@@ -198,34 +206,27 @@ def check_hold(case, run):
 
 
 def ringing_at_rest(case, run, speed, bound, late):
-    """A held prism whose speed at 1 s exceeds bound / 0.5 s fails, unless it is the diagnosed
-    start-up lurch (then an expected failure, with the numbers):
+    """A held prism whose speed at 1 s exceeds bound / 0.5 s fails, with what tells its cause.
 
-    Start from rest settles the prism with friction locked; its deformable base's Poisson
-    expansion under the weight is then restrained by the shear springs with forces beyond
-    Coulomb's limit at the corners (measured, seed 11: radial forces of 175 to 330 N on corners
-    whose limit tan(phi) N is 121 to 489 N), so the first dynamic step slips every corner and the
-    prism lurches (8e-5 m/s); the contacts lock again by the third step, but Shi's scheme keeps a
-    velocity that flips sign every step, v_{n+1} = 2 d / dt - v_n with d ~ 0, decaying by about
-    0.2% a step against the stiff springs: still 3e-6 m/s at 1 s while the centroid moves
-    1e-12 m from 0.5 s to 1 s. Recognised by: some closed contact sliding in the first step, no
-    creep (late < bound), and the velocity reversing in the next step.
+    Found by this sweep (seeds 11 and 33) and fixed in World::admitFriction: start from rest
+    settled the prism with friction locked, and the locked shear springs held its deformable
+    base's Poisson spread back with forces beyond Coulomb's limit (seed 11: radial forces of
+    175 to 330 N at corners whose limit tan(phi) N is 121 to 489 N), so the first dynamic step
+    slipped every corner and the prism lurched (8e-5 m/s); the contacts locked again, but Shi's
+    scheme kept a velocity flipping sign every step (v_{n+1} = 2 d / dt - v_n with d ~ 0): still
+    3.07e-6 m/s at 1 s while the centroid moved 1.5e-12 m from 0.5 s to 1 s. The message says
+    whether the velocity flips in the next step and how many contacts slid in the first one.
     """
     blk = yade_dda.block(run['prism'])
     v0 = np.array(blk.velocity[0:3])
     O.run(1, True)
     v1 = np.array(blk.velocity[0:3])
     first = run['firstStep']
-    flips = v0 @ v1 < 0
-    message = ('%s: speed %.3g m/s at 1 s > settlement bound / 0.5 s = %.3g m/s, though the centroid moved %.3g m '
-               'from 0.5 s to 1 s; the velocity %s in the next step (%.3g m/s); in the first step %d of %d closed '
-               'contacts slid and the speed became %.3g m/s (the settling leaves the shear springs beyond Coulomb\'s '
-               'limit; see ringing_at_rest)' % (R.describe(case), speed, bound / 0.5, late,
-                                                 'reverses' if flips else 'does not reverse', np.linalg.norm(v1),
-                                                 first['sliding'], first['closed'], first['speed']))
-    if first['sliding'] > 0 and flips and late < bound:
-        pytest.xfail(message)
-    pytest.fail(message)
+    pytest.fail('%s: speed %.3g m/s at 1 s > settlement bound / 0.5 s = %.3g m/s; the centroid moved %.3g m from '
+                '0.5 s to 1 s; the velocity %s in the next step (%.3g m/s); in the first step %d of %d closed '
+                'contacts slid and the speed became %.3g m/s'
+                % (R.describe(case), speed, bound / 0.5, late, 'reverses' if v0 @ v1 < 0 else 'does not reverse',
+                   np.linalg.norm(v1), first['sliding'], first['closed'], first['speed']))
 
 
 def states_summary(run):
