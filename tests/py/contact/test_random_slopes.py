@@ -44,7 +44,8 @@ The tolerances are not fitted to DDA: 1e-3 on a constant acceleration is far abo
 what an exact-for-constant-acceleration scheme with stiff penalty springs leaves and
 far below what a wrong friction law gives (a 1% error in tan(phi) changes a by
 FS / (1 - FS) %, at least 0.25 %). Default run: SEEDS (two regimes each, about 25 s);
-`-m slow` sweeps SLOW_SEEDS (about 3 minutes).
+`-m slow` sweeps SLOW_SEEDS (about 3 minutes); the three seeds it found failing also run by
+default (FOUND).
 
 What the sweep found. Held prisms rang after a start-up lurch (seeds 11, 33): start from
 rest left shear springs beyond Coulomb's limit (ringing_at_rest says how), fixed by letting
@@ -65,6 +66,7 @@ import random_slopes as R
 
 SEEDS = range(1, 7)
 SLOW_SEEDS = range(7, 67)
+FOUND = [('hold', 11), ('hold', 33), ('slide', 51)]    # SLOW_SEEDS the sweep found failing (test_cases_the_sweep_found)
 DT = 1e-3
 SAMPLES = (0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0)   # times [s] the run stops to check
 
@@ -402,6 +404,16 @@ def test_closed_forms_of_the_generator():
 def test_random_prism_on_random_incline(scene, regime, seed):
     """A random prism with FS >= 1.25 holds, with FS <= 0.8 slides at Coulomb's rate, the energy
     account balanced (module docstring)."""
+    check(regime, seed)
+
+
+@pytest.mark.parametrize('regime,seed', FOUND)
+def test_cases_the_sweep_found(scene, regime, seed):
+    """The sweep's seeds that failed, run by default so what they found stays found: a held
+    prism that rang after a start-up lurch (hold 11, 33; fixed in World::admitFriction,
+    ringing_at_rest says what it looked like) and the slide stalled by a step accepted with
+    its friction limits unsettled (slide 51; an expected failure while it is so,
+    stalled_slide)."""
     check(regime, seed)
 
 
