@@ -43,7 +43,7 @@ Oracles, per case, over 1 s:
 The tolerances are not fitted to DDA: 1e-3 on a constant acceleration is far above
 what an exact-for-constant-acceleration scheme with stiff penalty springs leaves and
 far below what a wrong friction law gives (a 1% error in tan(phi) changes a by
-FS / (1 - FS) %, at least 0.25 %). Default run: SEEDS (two regimes each, about 25 s);
+FS / (1 - FS) %, at least 0.25 %). Default run: SEEDS (two regimes each) and FOUND, 10 s idle, 25 s loaded;
 `-m slow` sweeps SLOW_SEEDS (about 3 minutes); the three seeds it found failing also run by
 default (FOUND).
 
