@@ -140,6 +140,9 @@ private:
 	// account restarted. Not converged within kSettleSteps (no equilibrium
 	// with these contacts): the scene is restored as placed.
 	void settle(const IntegratorSettings& settings);
+	// settle's static steps, and its second stage with the true friction.
+	bool settlingSteps(const IntegratorSettings& statics, double longest, double& reference, bool contracting);
+	void admitFriction(const IntegratorSettings& statics, double longest, double reference);
 	// frozen_ for settling: per block, 1 unless it settles (see settle).
 	void markSettlingBlocks();
 	// While settling: drops the contacts of two frozen (or fixed) blocks.

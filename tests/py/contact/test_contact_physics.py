@@ -420,7 +420,14 @@ def test_block_slides_down_incline(scene, phiDeg, tolerance, azimuth):
 def test_block_held_by_friction_on_incline(scene):
     """phi = 35 deg > 30 deg: static friction (needed tan 30 = 0.58 of N, available tan 35 = 0.70)
     holds the cube; in 2 s it moves less than 1e-4 m (elastic shear of the block and the
-    shear springs: ~1e-6 m)."""
+    shear springs: ~1e-6 m), and no contact carries more than its limit tan(phi) N.
+
+    Not every contact is locked: the springs share the downhill pull about equally (3188 N
+    per corner), but the uphill corners carry 2334 N of normal force, so their limit is
+    1634 N and they stand at it (state 'sliding', no slip: the block does not move), the
+    downhill ones (8710 N) take the rest locked. Before the start from rest ended with the
+    true friction (World::admitFriction) the uphill corners slipped in the first step, the
+    cube lurched and rang, and ended just under the limit (0.998 of it) as 'locked'."""
     geo, slab, block = S.build_incline(INCLINE, INCLINE_BLOCK, 35.0)
     O.engines = [integrator()]
     c0 = centroid(block)
@@ -428,7 +435,9 @@ def test_block_held_by_friction_on_incline(scene):
     assert S.norm(S.sub(centroid(block), c0)) < 1e-4
     assert S.norm(rotation_vector(block)) < 1e-4
     closed = [c for c in yade_dda.contacts() if c.state != 'open']
-    assert closed and all(c.state == 'locked' for c in closed)
+    mu = math.tan(math.radians(35.0))
+    assert closed and any(c.state == 'locked' for c in closed)
+    assert all(S.norm(tuple(c.shearForce)) <= mu * c.normalForce * (1 + 1e-6) for c in closed)
 
 
 @pytest.mark.parametrize('phiBlock,phiSlab', [(20.0, 45.0), (45.0, 20.0)], ids=['block-lower', 'slab-lower'])
