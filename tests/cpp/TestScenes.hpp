@@ -232,17 +232,20 @@ inline ContactSet contactSet(Collider& collider, const std::vector<Block>& block
 
 // A block as the narrow phase alone sees it: topology, corners and their mean
 // as the centroid [m]; `internal` marks faces covered by a neighbour (empty:
-// none).
+// none), `cover` their cover depths [m] (markInternalFaces; empty: unknown).
 struct NarrowBlock {
 	ConvexPolyhedron shape;
 	std::vector<Vector3> vertices;
 	Vector3 centroid = Vector3::Zero();
 	std::vector<char> internal;
+	std::vector<double> cover;
 	BlockGeometry geometry() const {
 		const bool any = std::find(internal.begin(), internal.end(), 1) != internal.end();
-		return {&shape, &vertices, centroid, any ? &internal : nullptr};
+		return {&shape, &vertices, centroid, any ? &internal : nullptr, nullptr,
+		        any && !cover.empty() ? &cover : nullptr};
 	}
 };
+
 
 // The convex hull of `points` as a NarrowBlock (no internal faces).
 inline NarrowBlock narrowBlock(const std::vector<Vector3>& points) {

@@ -55,35 +55,14 @@ constexpr double kLengthTolerance = 1e-9;  // [m]
 constexpr double kRoundoff = 1e-12;        // [m], round-off of unit-sized coordinates
 constexpr unsigned kSeed = 20261126;       // the random rotations'
 
-struct Solid {
-	dda::ConvexPolyhedron shape;
-	std::vector<Vector3> vertices;
-	Vector3 centroid = Vector3::Zero();
-	std::vector<char> internal;
-	std::vector<double> cover;
-	dda::BlockGeometry geometry() const {
-		bool any = false;
-		for (char c : internal) any = any || c;
-		return {&shape, &vertices, centroid, any ? &internal : nullptr, nullptr, any ? &cover : nullptr};
-	}
-};
+using Solid = dda::testing::NarrowBlock;
+using dda::testing::boxPoints;
 
+// The convex hull of R p for the points p.
 Solid makeSolid(const std::vector<Vector3>& points, const Matrix3& R) {
 	std::vector<Vector3> turned;
 	for (const Vector3& p : points) turned.push_back(R * p);
-	Solid s;
-	s.shape = dda::buildConvexPolyhedron(turned);
-	s.vertices = s.shape.vertices;
-	for (const Vector3& p : turned) s.centroid += p;
-	s.centroid /= static_cast<double>(turned.size());
-	return s;
-}
-
-std::vector<Vector3> boxPoints(const Vector3& lo, const Vector3& hi) {
-	std::vector<Vector3> p;
-	for (int k = 0; k < 8; ++k)
-		p.emplace_back(k & 1 ? hi.x() : lo.x(), k & 2 ? hi.y() : lo.y(), k & 4 ? hi.z() : lo.z());
-	return p;
+	return dda::testing::narrowBlock(turned);
 }
 
 // The wall on its neighbour, both marked by markInternalFaces (the core's own

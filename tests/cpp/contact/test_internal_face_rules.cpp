@@ -76,12 +76,7 @@ Block makeBlock(const std::vector<Vector3>& points, const Matrix3& R, const std:
 	return b;
 }
 
-std::vector<Vector3> boxPoints(const Vector3& lo, const Vector3& hi) {
-	std::vector<Vector3> p;
-	for (int k = 0; k < 8; ++k)
-		p.emplace_back(k & 1 ? hi.x() : lo.x(), k & 2 ? hi.y() : lo.y(), k & 4 ? hi.z() : lo.z());
-	return p;
-}
+using dda::testing::boxPoints;
 
 std::vector<Matrix3> rotations(int count) { return dda::testing::sceneRotations(kSeed, count); }
 
