@@ -29,13 +29,11 @@ double coverDepth(const std::vector<Vector3>& vertices, const std::vector<int>& 
                   const Vector3& d) {
 	const std::vector<Vector3>& v = *cover.vertices;
 	double depth = std::numeric_limits<double>::infinity();
-	for (int c : face) {
-		for (const std::vector<int>& k : cover.shape->faces) {
-			const Vector3 n = faceNormal(v, k);
-			const double along = n.dot(d);
-			if (!(along > 0)) continue;
-			depth = std::min(depth, std::max(0.0, n.dot(v[k[0]] - vertices[c])) / along);
-		}
+	for (const std::vector<int>& k : cover.shape->faces) {
+		const Vector3 n = faceNormal(v, k);
+		const double along = n.dot(d);
+		if (!(along > 0)) continue;
+		for (int c : face) depth = std::min(depth, std::max(0.0, n.dot(v[k[0]] - vertices[c])) / along);
 	}
 	return std::isfinite(depth) ? depth : 0.0;
 }
