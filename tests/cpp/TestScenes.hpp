@@ -247,6 +247,25 @@ struct NarrowBlock {
 };
 
 
+// The index of b's corner at p (within 1e-12 m), -1 when none.
+inline int vertexAt(const NarrowBlock& b, const Vector3& p) {
+	for (std::size_t v = 0; v < b.vertices.size(); ++v)
+		if ((b.vertices[v] - p).norm() < 1e-12) return static_cast<int>(v);
+	return -1;
+}
+
+// The face of `b` holding all of the given corners (within 1e-12 m), -1 when none.
+inline int faceWith(const NarrowBlock& b, const std::vector<Vector3>& points) {
+	for (std::size_t f = 0; f < b.shape.faces.size(); ++f) {
+		bool all = true;
+		for (const Vector3& p : points)
+			all = all && std::any_of(b.shape.faces[f].begin(), b.shape.faces[f].end(),
+			                         [&](int v) { return (b.vertices[v] - p).norm() < 1e-12; });
+		if (all) return static_cast<int>(f);
+	}
+	return -1;
+}
+
 // The convex hull of `points` as a NarrowBlock (no internal faces).
 inline NarrowBlock narrowBlock(const std::vector<Vector3>& points) {
 	NarrowBlock b;

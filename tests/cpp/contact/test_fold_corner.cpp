@@ -47,25 +47,8 @@ constexpr unsigned kSeed = 20261126;  // the random rotations'
 
 using Block = dda::testing::NarrowBlock;
 
-int vertexAt(const Block& b, const Vector3& p) {
-	for (std::size_t v = 0; v < b.vertices.size(); ++v)
-		if ((b.vertices[v] - p).norm() < 1e-12) return static_cast<int>(v);
-	return -1;
-}
-
-// The face of `b` holding all of the given corners, -1 when none.
-int faceWith(const Block& b, const std::vector<Vector3>& points) {
-	for (std::size_t f = 0; f < b.shape.faces.size(); ++f) {
-		bool all = true;
-		for (const Vector3& p : points) {
-			bool on = false;
-			for (int v : b.shape.faces[f]) on = on || (b.vertices[v] - p).norm() < 1e-12;
-			all = all && on;
-		}
-		if (all) return static_cast<int>(f);
-	}
-	return -1;
-}
+using dda::testing::faceWith;
+using dda::testing::vertexAt;
 
 Block makeBlock(const std::vector<Vector3>& points) { return dda::testing::narrowBlock(points); }
 

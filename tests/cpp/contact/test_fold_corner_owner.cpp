@@ -55,23 +55,8 @@ using Block = dda::testing::NarrowBlock;
 
 constexpr unsigned kSeed = 20261127;  // the random rotations'
 
-int vertexAt(const Block& b, const Vector3& p) {
-	for (std::size_t v = 0; v < b.vertices.size(); ++v)
-		if ((b.vertices[v] - p).norm() < 1e-12) return static_cast<int>(v);
-	return -1;
-}
-
-// The face of `b` holding all of the given corners, -1 when none.
-int faceWith(const Block& b, const std::vector<Vector3>& points) {
-	for (std::size_t f = 0; f < b.shape.faces.size(); ++f) {
-		bool all = true;
-		for (const Vector3& p : points)
-			all = all && std::any_of(b.shape.faces[f].begin(), b.shape.faces[f].end(),
-			                         [&](int v) { return (b.vertices[v] - p).norm() < 1e-12; });
-		if (all) return static_cast<int>(f);
-	}
-	return -1;
-}
+using dda::testing::faceWith;
+using dda::testing::vertexAt;
 
 // The point of triangle (a, b, c) nearest x (Ericson, Real-Time Collision
 // Detection, 5.1.5), by its Voronoi regions.
