@@ -232,13 +232,13 @@ inline ContactSet contactSet(Collider& collider, const std::vector<Block>& block
 
 // A block as the narrow phase alone sees it: topology, corners and their mean
 // as the centroid [m]; `internal` marks faces covered by a neighbour (empty:
-// none), `cover` their cover depths [m] (markInternalFaces; empty: unknown).
+// none), `cover` their covers (markInternalFaces' depths [m] and planes; empty: unknown).
 struct NarrowBlock {
 	ConvexPolyhedron shape;
 	std::vector<Vector3> vertices;
 	Vector3 centroid = Vector3::Zero();
 	std::vector<char> internal;
-	std::vector<double> cover;
+	std::vector<FaceCover> cover;
 	BlockGeometry geometry() const {
 		const bool any = std::find(internal.begin(), internal.end(), 1) != internal.end();
 		return {&shape, &vertices, centroid, any ? &internal : nullptr, nullptr,

@@ -127,6 +127,7 @@
 #include "Distance.hpp"
 #include "Linearization.hpp"
 #include "dda/geometry/ConvexPolyhedron.hpp"
+#include "dda/geometry/InternalFaces.hpp"
 #include "dda/geometry/SubUnits.hpp"
 
 #include <array>
@@ -197,12 +198,13 @@ struct BlockGeometry {
 	// Optional: the block's planes for its current corners (BlockPlanes); when
 	// absent the narrow phase builds what it needs per call.
 	const BlockPlanes* planes = nullptr;
-	// Optional, per face (with internalFaces): how far past an internal face's
-	// plane its flush neighbour surely reaches over the whole face [m]
-	// (markInternalFaces' cover depth; 0 where not known). A corner of the
-	// other block just past such a face, inside that reach, is inside the
-	// fixed mass, at the seam of the two blocks (ownEntranceContact).
-	const std::vector<double>* coverDepths = nullptr;
+	// Optional, per face (with internalFaces): what covers an internal face
+	// (markInternalFaces' FaceCover: how far past its plane the flush
+	// neighbour surely reaches over the whole face [m], and the neighbour's
+	// other face planes). A corner of the other block just past such a face,
+	// inside that reach, is inside the fixed mass, at the seam of the two
+	// blocks (ownEntranceContact).
+	const std::vector<FaceCover>* covers = nullptr;
 };
 
 // Which feature is the pair's entrance feature (step 2).

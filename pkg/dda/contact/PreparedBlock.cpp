@@ -61,7 +61,7 @@ Prepared prepareBounds(const BlockGeometry& block) {
 	p.vertices = block.vertices;
 	p.centroid = block.centroid;
 	p.internalFaces = block.internalFaces;
-	p.coverDepths = block.coverDepths;
+	p.covers = block.covers;
 	p.planes = block.planes;
 	if (p.planes) {
 		p.lower = p.planes->lower;

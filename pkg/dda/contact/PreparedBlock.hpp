@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 namespace dda::narrow {
@@ -87,7 +88,7 @@ struct Prepared {
 	int faceTotal = 0;
 	Vector3 lower = Vector3::Zero(), upper = Vector3::Zero();  // bounding box [m]
 	const std::vector<char>* internalFaces = nullptr;
-	const std::vector<double>* coverDepths = nullptr;  // BlockGeometry::coverDepths
+	const std::vector<FaceCover>* covers = nullptr;  // BlockGeometry::covers
 	// The sub-units the narrow phase may use (all, or those a broad phase
 	// linked to the pair), and per corner whether it is one of them.
 	Indices vertexList, edgeList, faceList;
@@ -100,7 +101,12 @@ struct Prepared {
 	// entrance, and its edges give no edge axes.
 	bool internal(int f) const { return internalFaces && (*internalFaces)[f]; }
 	// How far past internal face f its flush neighbour surely reaches [m] (0: unknown).
-	double coverDepth(int f) const { return coverDepths ? (*coverDepths)[f] : 0.0; }
+	double coverDepth(int f) const { return covers ? (*covers)[f].depth : 0.0; }
+	// How deep x lies inside internal face f's flush neighbour from the
+	// neighbour's other faces [m] (-infinity: unknown).
+	double depthInCover(int f, const Vector3& x) const {
+		return covers ? (*covers)[f].depthInside(x) : -std::numeric_limits<double>::infinity();
+	}
 	bool internalEdge(int e) const {
 		return internalFaces && ((*internalFaces)[shape->edgeFaces[e][0]] || (*internalFaces)[shape->edgeFaces[e][1]]);
 	}

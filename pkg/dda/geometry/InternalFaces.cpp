@@ -20,6 +20,13 @@ bool insideFacePolygon(const Vector3& x, const std::vector<Vector3>& vertices, c
 	return true;
 }
 
+double FaceCover::depthInside(const Vector3& x) const {
+	if (planes.empty()) return -std::numeric_limits<double>::infinity();
+	double depth = std::numeric_limits<double>::infinity();
+	for (const Eigen::Vector4d& p : planes) depth = std::min(depth, p.w() - p.head<3>().dot(x));
+	return depth;
+}
+
 namespace {
 // The shortest chord [m] of convex body `cover` along unit direction d from
 // the corners of `face` (corners of `vertices` on cover's surface, on the face
@@ -38,11 +45,26 @@ double coverDepth(const std::vector<Vector3>& vertices, const std::vector<int>& 
 	return std::isfinite(depth) ? depth : 0.0;
 }
 
+// The cover of `face` (of `vertices`, outward normal n) by body `cover`,
+// whose face `covering` lies on it: see FaceCover.
+FaceCover faceCover(const std::vector<Vector3>& vertices, const std::vector<int>& face, const PlacedPolyhedron& cover,
+                    int covering, const Vector3& n) {
+	FaceCover out;
+	out.depth = coverDepth(vertices, face, cover, n);
+	const std::vector<Vector3>& v = *cover.vertices;
+	for (std::size_t k = 0; k < cover.shape->faces.size(); ++k) {
+		if (static_cast<int>(k) == covering) continue;
+		const Vector3 m = faceNormal(v, cover.shape->faces[k]);
+		out.planes.emplace_back(m.x(), m.y(), m.z(), m.dot(v[cover.shape->faces[k][0]]));
+	}
+	return out;
+}
+
 // Marks the faces of bodies a and b that cover each other (see markInternalFaces),
-// and with depth vectors the covers' depths.
+// and with cover vectors their covers (the deepest when several bodies cover a face).
 void markCoveredFaces(const PlacedPolyhedron& A, const PlacedPolyhedron& B, double tolerance,
                       double parallelAngleTolerance, std::vector<char>& internalA, std::vector<char>& internalB,
-                      std::vector<double>* depthA, std::vector<double>* depthB) {
+                      std::vector<FaceCover>* coverA, std::vector<FaceCover>* coverB) {
 	const std::vector<Vector3>& verticesA = *A.vertices;
 	const std::vector<Vector3>& verticesB = *B.vertices;
 	for (std::size_t f = 0; f < A.shape->faces.size(); ++f) {
@@ -61,10 +83,14 @@ void markCoveredFaces(const PlacedPolyhedron& A, const PlacedPolyhedron& B, doub
 				gCovered = gCovered && insideFacePolygon(verticesB[v], verticesA, A.shape->faces[f], nf, tolerance);
 			if (fCovered) internalA[f] = 1;
 			if (gCovered) internalB[g] = 1;
-			if (fCovered && depthA)
-				(*depthA)[f] = std::max((*depthA)[f], coverDepth(verticesA, A.shape->faces[f], B, nf));
-			if (gCovered && depthB)
-				(*depthB)[g] = std::max((*depthB)[g], coverDepth(verticesB, B.shape->faces[g], A, ng));
+			if (fCovered && coverA) {
+				FaceCover c = faceCover(verticesA, A.shape->faces[f], B, static_cast<int>(g), nf);
+				if ((*coverA)[f].planes.empty() || c.depth > (*coverA)[f].depth) (*coverA)[f] = std::move(c);
+			}
+			if (gCovered && coverB) {
+				FaceCover c = faceCover(verticesB, B.shape->faces[g], A, static_cast<int>(f), ng);
+				if ((*coverB)[g].planes.empty() || c.depth > (*coverB)[g].depth) (*coverB)[g] = std::move(c);
+			}
 		}
 	}
 }
@@ -72,16 +98,16 @@ void markCoveredFaces(const PlacedPolyhedron& A, const PlacedPolyhedron& B, doub
 
 void markInternalFaces(const std::vector<PlacedPolyhedron>& bodies, double relativeLengthTolerance,
                        double parallelAngleTolerance, std::vector<std::vector<char>>& internal,
-                       std::vector<std::vector<double>>* coverDepths) {
+                       std::vector<std::vector<FaceCover>>* covers) {
 	internal.assign(bodies.size(), {});
-	if (coverDepths) coverDepths->assign(bodies.size(), {});
+	if (covers) covers->assign(bodies.size(), {});
 	std::vector<int> given;
 	std::vector<Eigen::AlignedBox3d> boxes(bodies.size());
 	for (std::size_t b = 0; b < bodies.size(); ++b) {
 		if (!bodies[b].shape) continue;
 		given.push_back(static_cast<int>(b));
 		internal[b].assign(bodies[b].shape->faces.size(), 0);
-		if (coverDepths) (*coverDepths)[b].assign(bodies[b].shape->faces.size(), 0.0);
+		if (covers) (*covers)[b].assign(bodies[b].shape->faces.size(), FaceCover{});
 		for (const Vector3& x : *bodies[b].vertices) boxes[b].extend(x);
 	}
 	std::sort(given.begin(), given.end(), [&](int a, int b) { return boxes[a].min().x() < boxes[b].min().x(); });
@@ -97,7 +123,7 @@ void markInternalFaces(const std::vector<PlacedPolyhedron>& bodies, double relat
 			grown.max().array() += tolerance;
 			if (!grown.intersects(boxes[b])) continue;
 			markCoveredFaces(bodies[a], bodies[b], tolerance, parallelAngleTolerance, internal[a], internal[b],
-			                 coverDepths ? &(*coverDepths)[a] : nullptr, coverDepths ? &(*coverDepths)[b] : nullptr);
+			                 covers ? &(*covers)[a] : nullptr, covers ? &(*covers)[b] : nullptr);
 		}
 	}
 }

@@ -144,7 +144,7 @@ void ContactDetection::markFixedBlocks(const std::vector<Block>& blocks, std::ve
 	std::vector<PlacedPolyhedron> fixed(blocks.size());
 	for (std::size_t b = 0; b < blocks.size(); ++b)
 		if (blocks[b].fixed) fixed[b] = PlacedPolyhedron{blocks[b].shape.get(), &blocks[b].vertices};
-	markInternalFaces(fixed, kDefaultRelativeLengthTolerance, kDefaultParallelAngleTolerance, flags, &coverDepths_);
+	markInternalFaces(fixed, kDefaultRelativeLengthTolerance, kDefaultParallelAngleTolerance, flags, &covers_);
 	coverDepthsBlocks_ = static_cast<int>(blocks.size());
 }
 
@@ -263,8 +263,8 @@ void ContactDetection::detectChunk(Step& step, int begin, int count, int chunk) 
 			    pairDetectionSettings(diagonals_[a], diagonals_[b], stats.contactDistance, stats.allowedDisplacement);
 			const std::vector<char>* internalA = internalFaces_[a].empty() ? nullptr : &internalFaces_[a];
 			const std::vector<char>* internalB = internalFaces_[b].empty() ? nullptr : &internalFaces_[b];
-			const std::vector<double>* coverA = coverDepths_[a].empty() ? nullptr : &coverDepths_[a];
-			const std::vector<double>* coverB = coverDepths_[b].empty() ? nullptr : &coverDepths_[b];
+			const std::vector<FaceCover>* coverA = covers_[a].empty() ? nullptr : &covers_[a];
+			const std::vector<FaceCover>* coverB = covers_[b].empty() ? nullptr : &covers_[b];
 			pairFound_[q] = detectPairContacts(
 			    BlockGeometry{A.shape.get(), &A.vertices, interiorPoint(A), internalA, &planes_[planeSlot_[a]], coverA},
 			    BlockGeometry{B.shape.get(), &B.vertices, interiorPoint(B), internalB, &planes_[planeSlot_[b]], coverB},

@@ -66,7 +66,7 @@ private:
 	};
 	void findPairs(const std::vector<Block>& blocks, Collider& collider, bool reusePairs, StepStatistics& stats);
 	void updateInternalFaces(const std::vector<Block>& blocks);
-	// coverDepths_ of the fixed blocks (markInternalFaces), their flags in `flags`.
+	// covers_ of the fixed blocks (markInternalFaces), their flags in `flags`.
 	void markFixedBlocks(const std::vector<Block>& blocks, std::vector<std::vector<char>>& flags);
 	// Before the first chunk (and after the per-block diagonals): each
 	// block's last chunk, the planes' free list and the chunk's pooled results.
@@ -114,11 +114,12 @@ private:
 	// Faces of fixed blocks covered by a flush neighbour (BlockGeometry::internalFaces).
 	std::vector<std::vector<char>> internalFaces_;
 	int internalFacesBlocks_ = -1;  // block count when internalFaces_ was computed
-	// Per fixed block and face, how far its flush neighbour surely reaches past
-	// a covered face (BlockGeometry::coverDepths). Not saved: computed again
+	// Per fixed block and face, what covers it: how far its flush neighbour
+	// surely reaches past a covered face, and the neighbour's other planes
+	// (BlockGeometry::covers). Not saved: computed again
 	// from the fixed blocks (which never move) after a load, the same doubles.
-	std::vector<std::vector<double>> coverDepths_;
-	int coverDepthsBlocks_ = -1;  // block count when coverDepths_ was computed
+	std::vector<std::vector<FaceCover>> covers_;
+	int coverDepthsBlocks_ = -1;  // block count when covers_ was computed
 	std::vector<double> pairArea_;  // per pair of the chunk, its contact area [m^2] (found pairs)
 	double contactsPerPair_ = 1;    // the last chunk's contacts per candidate pair (its estimate for the next)
 	std::vector<int> pairFirst_;    // per found pair of the chunk, where its contacts start among the chunk's

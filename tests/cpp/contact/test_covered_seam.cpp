@@ -25,6 +25,14 @@
 // And where q is outside the fixed mass, no contact: a floor thinner than dz
 // (q below it), and a wedge-shaped neighbour under W that thins to nothing
 // at W's inner edge (cover depth 0: q outside the wedge for dz > 1.25 e).
+// And where q lies on the fixed mass's surface at a junction of fixed
+// blocks, no contact deeper than the pair's overlap: a fixed tetrahedron T
+// whose three side faces are each covered by a fixed frustum (a cut rock
+// mass's block held among its held neighbours, only its base exposed), and
+// a free block whose lowest corner rests on T's apex, within the contact
+// distance of T's base. The corner is past no
+// covered face and on every frustum's surface; measured against T's base, its
+// only exposed face, it would take the tetrahedron's height as its depth.
 // Each placement is turned by random rotations (seed printed), both orders.
 // Units: m.
 #include "TestScenes.hpp"
@@ -71,11 +79,11 @@ Solid wallOn(const std::vector<Vector3>& neighbour, const Matrix3& R) {
 	Solid wall = makeSolid(boxPoints({-1, -0.4, 0}, {1, 0, 2}), R);
 	const Solid below = makeSolid(neighbour, R);
 	std::vector<std::vector<char>> flags;
-	std::vector<std::vector<double>> depths;
+	std::vector<std::vector<dda::FaceCover>> covers;
 	dda::markInternalFaces({{&wall.shape, &wall.vertices}, {&below.shape, &below.vertices}}, 1e-9, 1e-6, flags,
-	                       &depths);
+	                       &covers);
 	wall.internal = flags[0];
-	wall.cover = depths[0];
+	wall.cover = covers[0];
 	return wall;
 }
 
@@ -85,19 +93,19 @@ Solid tetrahedron(double x0, double e, double dz, const Matrix3& R) {
 	return makeSolid({q, q + Vector3(0.3, 0.5, 0.4), q + Vector3(-0.3, 0.5, 0.4), q + Vector3(0.05, 0.3, 0.9)}, R);
 }
 
-DetectionSettings settings() {
+DetectionSettings settings(double contactDistance = 0.01) {
 	DetectionSettings s;
-	s.contactDistance = 0.01;
+	s.contactDistance = contactDistance;
 	s.lengthTolerance = kLengthTolerance;
 	s.hysteresis = 0.001;
 	return s;
 }
 
-std::vector<PairContacts> bothOrders(const Solid& wall, const Solid& block) {
+std::vector<PairContacts> bothOrders(const Solid& wall, const Solid& block, double contactDistance = 0.01) {
 	std::vector<PairContacts> out;
 	for (const bool swap : {false, true}) {
-		const auto r = swap ? dda::detectPairContacts(wall.geometry(), block.geometry(), settings())
-		                    : dda::detectPairContacts(block.geometry(), wall.geometry(), settings());
+		const auto r = swap ? dda::detectPairContacts(wall.geometry(), block.geometry(), settings(contactDistance))
+		                    : dda::detectPairContacts(block.geometry(), wall.geometry(), settings(contactDistance));
 		out.push_back(r ? *r : PairContacts{});
 	}
 	return out;
@@ -120,7 +128,7 @@ TEST(CoveredSeam, ACornerUnderAWallInsideTheFloorIsHeldByTheWallsInnerFace) {
 		for (std::size_t f = 0; f < wall.internal.size(); ++f) {
 			if (!wall.internal[f]) continue;
 			++covered;
-			EXPECT_NEAR(wall.cover[f], 0.5, kRoundoff) << "the floor's thickness under the wall";
+			EXPECT_NEAR(wall.cover[f].depth, 0.5, kRoundoff) << "the floor's thickness under the wall";
 		}
 		ASSERT_EQ(covered, 1);
 		const Vector3 inward = R * Vector3::UnitY();  // G's outward normal
@@ -155,7 +163,7 @@ TEST(CoveredSeam, ACornerOutsideTheFixedMassHasNoCompressedContactWithTheWall) {
 		                             R);
 		for (const Solid* wall : {&onThin, &onWedge}) {
 			for (std::size_t f = 0; f < wall->internal.size(); ++f)
-				if (wall->internal[f] && wall == &onWedge) EXPECT_EQ(wall->cover[f], 0.0) << "the wedge thins to nothing";
+				if (wall->internal[f] && wall == &onWedge) EXPECT_EQ(wall->cover[f].depth, 0.0) << "the wedge thins to nothing";
 			const double e = 1e-4, dz = 3e-4;
 			std::ostringstream trace;
 			trace << "rotation\n" << R << (wall == &onThin ? "\nthin floor" : "\nwedge");
@@ -166,6 +174,56 @@ TEST(CoveredSeam, ACornerOutsideTheFixedMassHasNoCompressedContactWithTheWall) {
 				SCOPED_TRACE(dda::testing::describePair(r));
 				for (const SubContact& c : cornerContacts(r, q)) EXPECT_GE(c.gap, -kLengthTolerance);
 			}
+		}
+	}
+}
+
+TEST(CoveredSeam, ACornerOnTheApexOfAHeldTetrahedronHasNoContactBeyondTheOverlap) {
+	std::printf("CoveredSeam: random rotations of seed %u\n", kSeed);
+	// T is flat (0.03 m high, 2 m wide), the contact distance 0.1 m: the apex
+	// is within reach of T's base, as in a rock mass cut at 1 m with a
+	// contact distance of a few cm.
+	const Vector3 apex(0.1, 0.2, 0.03);
+	const std::vector<Vector3> base{{-1, -0.8, 0}, {1.1, -0.6, 0}, {-0.2, 1, 0}};
+	for (const Matrix3& R : dda::testing::sceneRotations(kSeed, 5)) {
+		Solid held = makeSolid({base[0], base[1], base[2], apex}, R);
+		// Each side face extruded 0.5 m outwards into a frustum widening by
+		// 0.3 of the face's size: a block covering the face whole, 0.5 m deep
+		// over it (its sides lean outwards).
+		std::vector<Solid> covers3;
+		const Vector3 inside = R * ((base[0] + base[1] + base[2] + apex) / 4);
+		for (int k = 0; k < 3; ++k) {
+			const Vector3 a = R * base[k], b = R * base[(k + 1) % 3], c = R * apex;
+			Vector3 n = (b - a).cross(c - a).normalized();
+			if (n.dot(a - inside) < 0) n = -n;
+			const Vector3 m = (a + b + c) / 3;
+			auto top = [&](const Vector3& p) -> Vector3 { return p + 0.5 * n + 0.3 * (p - m); };
+			covers3.push_back(dda::testing::narrowBlock({a, b, c, top(a), top(b), top(c)}));
+		}
+		std::vector<dda::PlacedPolyhedron> fixed{{&held.shape, &held.vertices}};
+		for (const Solid& p : covers3) fixed.push_back({&p.shape, &p.vertices});
+		std::vector<std::vector<char>> flags;
+		std::vector<std::vector<dda::FaceCover>> covers;
+		dda::markInternalFaces(fixed, 1e-9, 1e-6, flags, &covers);
+		held.internal = flags[0];
+		held.cover = covers[0];
+		int covered = 0;
+		for (std::size_t f = 0; f < held.internal.size(); ++f) {
+			if (!held.internal[f]) continue;
+			++covered;
+			EXPECT_NEAR(held.cover[f].depth, 0.5, kRoundoff) << "the frustum's height over the face";
+		}
+		ASSERT_EQ(covered, 3) << "every side face is covered, the base is exposed";
+		// A tetrahedron standing on its lowest corner, the apex, above T.
+		const Solid block = makeSolid({apex, apex + Vector3(0.3, 0.1, 0.5), apex + Vector3(-0.2, 0.25, 0.5),
+		                               apex + Vector3(-0.1, -0.3, 0.5)},
+		                              R);
+		std::ostringstream trace;
+		trace << "rotation\n" << R;
+		SCOPED_TRACE(trace.str());
+		for (const PairContacts& r : bothOrders(held, block, 0.1)) {
+			SCOPED_TRACE(dda::testing::describePair(r));
+			for (const SubContact& c : r.contacts) EXPECT_GE(c.gap, -kLengthTolerance) << "the blocks only touch";
 		}
 	}
 }
