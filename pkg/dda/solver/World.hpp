@@ -136,12 +136,13 @@ private:
 	// step long enough to weigh 1e-3 of a contact's stiffness) with friction
 	// locked, for the blocks at rest whose touching contacts join them to a
 	// fixed block or point (the rest frozen), until a step moves no vertex by
-	// more than kSettleTolerance of the first's; then velocities zero, the
-	// account restarted. Not converged within kSettleSteps (no equilibrium
-	// with these contacts): the scene is restored as placed.
+	// more than kSettleTolerance of the first's, or several in a row move them
+	// by no more than kSettleQuiet of it; then velocities zero, the account
+	// restarted. Not converged within kSettleSteps (no equilibrium with these
+	// contacts): the scene is restored as placed.
 	void settle(const IntegratorSettings& settings);
 	// settle's static steps, and its second stage with the true friction.
-	bool settlingSteps(const IntegratorSettings& statics, double longest, double& reference, bool contracting);
+	bool settlingSteps(const IntegratorSettings& statics, double longest, double& reference);
 	void admitFriction(const IntegratorSettings& statics, double longest, double reference);
 	// frozen_ for settling: per block, 1 unless it settles (see settle).
 	void markSettlingBlocks();
