@@ -335,6 +335,76 @@ def test_contact_changes_add_no_energy(scene, kind, seed, side, steps):
         (describe(case), len(gains)) + max(gains, key=lambda g: g[1] - g[2]))
 
 
+# ================================================================ at rest after the start from rest
+
+# Joints dipping below the friction angle hold: a confined mass settled from rest must stay there.
+AT_REST_SPEED = 1e-3   # [m/s] every free block slower than this at the end
+REST_RUNS = ([('junctions', 0, 5.0, 0.2), ('oblique', 1, SIDE, 0.2)]
+             + [pytest.param(kind, seed, SIDE, 0.5, marks=pytest.mark.slow)
+                for kind in ('oblique', 'orthogonal') for seed in (1, 2, 3, 4, 5)]
+             + [pytest.param('junctions', 0, 5.0, 0.5, marks=pytest.mark.slow)])
+
+
+@functools.lru_cache(maxsize=None)
+def rest_run(kind, seed, side, duration):
+    """Starts the case from rest (DDAIntegrator's default) at dt = 1e-3 s and runs it
+    for `duration` [s]; returns the case, the first step's stats, the per-step
+    energies, solves and cuts, and the free blocks' largest speed at the end."""
+    O.reset()
+    case = case_of(kind, seed, side)
+    ids, _, free = R.build_scene(case, dt=DT)
+    O.step()
+    first = dict(yade_dda.stats())
+    energies, solves, cuts = [dict(first['energy'])], [first['openCloseIterations']], [first['stepCuts']]
+    while O.time < duration:
+        O.step()
+        s = yade_dda.stats()
+        energies.append(dict(s['energy']))
+        solves.append(s['openCloseIterations'])
+        cuts.append(s['stepCuts'])
+    speed = max(O.bodies[i].state.vel.norm() for i in free)
+    result = (case, first, len(free), energies, solves, cuts, speed)
+    O.reset()
+    return result
+
+
+@pytest.mark.parametrize('kind, seed, side, duration', REST_RUNS)
+def test_a_confined_mass_settles_and_stays_at_rest(scene, kind, seed, side, duration):
+    case, first, free, energies, solves, cuts, speed = rest_run(kind, seed, side, duration)
+    print(describe(case), 'settle steps', first['settleSteps'], 'mean solves %.2f' % (sum(solves) / len(solves)),
+          'cuts', sum(cuts), 'largest speed %.3g m/s' % speed)
+    assert first['settleConverged'] and first['settledBlocks'] == free, (
+        '%s: start from rest: converged %s, %d of %d free blocks settled in %d static steps'
+        % (describe(case), first['settleConverged'], first['settledBlocks'], free, first['settleSteps']))
+    assert speed < AT_REST_SPEED, '%s: a free block at %.3g m/s after %g s' % (describe(case), speed, duration)
+
+
+@pytest.mark.parametrize('kind, seed, side, duration', REST_RUNS)
+def test_a_settled_mass_keeps_its_energy_account(scene, kind, seed, side, duration):
+    case, first, _, energies, _, _, _ = rest_run(kind, seed, side, duration)
+    drifts = account_drifts(energies[0], energies[1:])
+    assert not drifts, '%s: the account drifts at %d steps; first: step %d, %.3g J (largest term %.3g J, largest ' \
+        'change %.3g J)' % ((describe(case), len(drifts)) + drifts[0])
+    gains = contact_change_gains(energies[0], energies[1:])
+    assert not gains, '%s: contact changes added energy at %d steps; largest: step %d, %.3g J (allowed %.3g J)' % (
+        (describe(case), len(gains)) + max(gains, key=lambda g: g[1] - g[2]))
+
+
+@pytest.mark.parametrize('kind, seed, side, duration', REST_RUNS)
+def test_a_settled_mass_needs_few_solves_and_no_cut(scene, kind, seed, side, duration):
+    """The target: at most 5 open-close solves a step on average and the time step at
+    its maximum. Not met yet: contacts on steep joints that carry next to no load keep
+    changing state (7 to 15 solves a step, a few cuts on orthogonal stacks); reported
+    as an expected failure with its numbers, a failure beyond 20 solves or 10 cuts."""
+    case, _, _, _, solves, cuts, _ = rest_run(kind, seed, side, duration)
+    mean = sum(solves) / len(solves)
+    message = '%s: %.2f open-close solves a step on average (most %d), %d step cuts in %d steps' % (
+        describe(case), mean, max(solves), sum(cuts), len(solves))
+    assert mean <= 20 and sum(cuts) <= 10, message
+    if mean > 5 or sum(cuts):
+        pytest.xfail(message)
+
+
 # ================================================================ colliders and threads
 
 def contact_set():
