@@ -227,26 +227,97 @@ def snapshot(ids, shapes=None):
     return {i: shapes[i].moved([tuple(v) for v in yade_dda.block(i).vertices]) for i in ids}
 
 
-def depth_violations(contacts, shapes, absolute=1e-9, relative=1e-9):
+def depth_violations(contacts, shapes, absolute=1e-9, relative=1e-9, fixed_mass=None):
     """The sub-contacts deeper than their pair's exact overlap.
 
-    contacts: (id1, id2, gap, label) per sub-contact, gap [m] measured on the
-    geometry of `shapes` ({body id: Convex}), label anything to report (kind,
-    type, state). A sub-contact violates when gap < -(penetration of (id1,
-    id2)) - tol, with tol = absolute [m] + relative x the pair's largest corner
-    coordinate. Returns a list of (id1, id2, label, gap, penetration, tol),
-    largest excess first."""
+    contacts: (id1, id2, gap, label) or (id1, id2, gap, label, point) per
+    sub-contact, gap [m] measured on the geometry of `shapes` ({body id:
+    Convex}), label anything to report (kind, type, state). A sub-contact
+    violates when gap < -(penetration of (id1, id2)) - tol, with tol = absolute
+    [m] + relative x the pair's largest corner coordinate. With `fixed_mass`
+    (a FixedMass of the held blocks, whose ids are its `ids`), a vertex-face
+    contact of a free block's corner (id1, the corner nearest `point`) on a
+    held block (id2) may be as deep as the corner lies in the held mass: at a
+    seam of two held blocks the pair's overlap measures only the way out
+    across the joint, into the neighbour. Returns a list of (id1, id2, label,
+    gap, penetration, tol), largest excess first."""
     cache, out = {}, []
-    for id1, id2, gap, state in contacts:
+    for entry in contacts:
+        id1, id2, gap, state = entry[:4]
         key = (min(id1, id2), max(id1, id2))
         if key not in cache:
             A, B = shapes[key[0]], shapes[key[1]]
             cache[key] = (penetration(A, B), absolute + relative * coordinate_scale(A, B))
         depth, tol = cache[key]
         if gap < -depth - tol:
+            if (fixed_mass is not None and len(entry) > 4 and str(state).startswith('VF') and id2 in fixed_mass.ids
+                    and id1 not in fixed_mass.ids):
+                corners = shapes[id1].vertices
+                corner = corners[np.argmin(((corners - np.asarray(entry[4])) ** 2).sum(axis=1))]
+                if fixed_mass.reaches(corner, -gap - tol):
+                    continue
             out.append((id1, id2, state, gap, depth, tol))
     out.sort(key=lambda v: v[3] + v[4])
     return out
+
+
+class FixedMass:
+    """The union of the held blocks (`Convex` each) of a cut mass [m]: a corner's depth in it.
+
+    Neighbouring blocks of `cutRockMass` share faces exactly, so a face of a held block
+    is either covered whole by an opposed face of another held block (the same corners:
+    inside the mass) or exposed; the mass's surface is the union of the exposed faces.
+    A point inside some held block lies at least d inside the mass when no exposed face
+    polygon comes within d of it."""
+
+    def __init__(self, shapes):
+        self.ids = set(shapes)
+        self.blocks = list(shapes.values())
+        key = lambda pts: tuple(sorted(tuple(np.round(p, 9)) for p in pts))
+        count = {}
+        faces = []
+        for b in self.blocks:
+            for f in b.faces:
+                pts = b.vertices[list(f)]
+                k = key(pts)
+                count[k] = count.get(k, 0) + 1
+                faces.append((k, pts))
+        self.exposed = [pts for k, pts in faces if count[k] == 1]
+        self.planes = []   # per block: outward unit normals and offsets (n . x - o > 0 outside)
+        for b in self.blocks:
+            n = _unit_rows(b.face_normals())
+            o = np.array([n[k] @ b.vertices[f[0]] for k, f in enumerate(b.faces)])
+            flip = np.where(n @ b.vertices.mean(axis=0) - o > 0, -1.0, 1.0)
+            self.planes.append((n * flip[:, None], o * flip))
+        self.low = np.array([p.min(axis=0) for p in self.exposed])
+        self.high = np.array([p.max(axis=0) for p in self.exposed])
+
+    def inside(self, x, tol=1e-12):
+        return any(np.all(n @ x - o <= tol) for n, o in self.planes)
+
+    def reaches(self, x, depth):
+        """True when x lies in the mass at least `depth` [m] from its surface."""
+        if not self.inside(x):
+            return depth <= 0
+        near = np.all((self.low <= x + depth) & (self.high >= x - depth), axis=1)
+        return all(_polygon_distance(x, self.exposed[k]) >= depth for k in np.nonzero(near)[0])
+
+
+def _polygon_distance(x, pts):
+    """The distance [m] from point x to the planar convex polygon of corners `pts` (in order)."""
+    n = np.cross(pts[1] - pts[0], pts[2] - pts[0])
+    n = n / np.linalg.norm(n)
+    h = n @ (x - pts[0])
+    p = x - h * n
+    edges = np.roll(pts, -1, axis=0) - pts
+    side = np.cross(edges, p - pts) @ n
+    if np.all(side >= 0) or np.all(side <= 0):
+        return abs(h)
+    best = np.inf
+    for a, e in zip(pts, edges):
+        t = min(1.0, max(0.0, (x - a) @ e / (e @ e)))
+        best = min(best, np.linalg.norm(x - (a + t * e)))
+    return best
 
 
 def rest_account(free):

@@ -12,7 +12,10 @@ stored answer (SI units: m, s, kg, J). Every failure message names the case
   each sub-contact of contacts() (kept from the last step or new) has a gap
   [at the start of the step] >= -(the exact overlap of its two blocks on the
   corners read before that step) - (1e-9 m + 1e-9 x the largest corner
-  coordinate). And none is deeper than 0.1 mm at E = 1e9 Pa.
+  coordinate); a free block's corner on a held block may be as deep as it
+  lies in the held mass (rockmass_scenes.FixedMass: at a seam of two held
+  blocks the pair's overlap measures only the way out across the joint,
+  into the neighbour). And none is deeper than 0.1 mm at E = 1e9 Pa.
 - The energy account balances: kinetic + gravity + strain + contact + friction
   + damping - loads - contactChanges stays at its value before the first step
   (the placed mass at rest: the free blocks' m g z) to 1e-6 of the largest
@@ -206,6 +209,30 @@ def test_depth_check_flags_contacts_deeper_than_their_pairs_overlap():
     assert found[2][5] == pytest.approx(1e-9 + 1e-9 * 1.999)
 
 
+def test_depth_check_allows_a_corner_as_deep_as_it_lies_in_the_held_mass():
+    """Held cubes A = [0,1]^3 and B = [1,2] x [0,1] x [0,1] meet flush at x = 1 (the
+    seam); a free block's lowest corner q sits 0.1 mm past the seam in B and 1 mm below
+    the mass's top. Against A's top face its gap is -1 mm while the pair (free, A)
+    only touches: allowed, since q lies 1 mm deep in the held mass (FixedMass: its
+    nearest exposed face is the top; the seam faces are covered). A gap of -2 mm, or
+    -1 mm for a corner on the top surface, is flagged; so is the -1 mm contact when no
+    held mass is given."""
+    A, B = cube((0, 0, 0), (1, 1, 1)), cube((1, 0, 0), (2, 1, 1))
+    held = R.FixedMass({1: A, 2: B})
+    assert len(held.exposed) == 10      # the two seam faces cover each other
+    q = (1.0001, 0.5, 0.999)
+    corners = [q, (1.3, 0.6, 1.5), (1.2, 0.2, 1.5), (1.5, 0.4, 1.6)]
+    free = Convex(corners, [(0, 1, 2), (0, 2, 3), (0, 3, 1), (1, 3, 2)])
+    on_top = Convex([(1.5, 0.5, 1.0)] + corners[1:], [(0, 1, 2), (0, 2, 3), (0, 3, 1), (1, 3, 2)])
+    shapes = {1: A, 2: B, 3: free, 4: on_top}
+    assert penetration(free, A) == 0.0
+    seam = [(3, 1, -1e-3, 'VF/VF locked', q)]
+    assert depth_violations(seam, shapes, fixed_mass=held) == []
+    assert [v[2] for v in depth_violations(seam, shapes)] == ['VF/VF locked']
+    deep = [(3, 1, -2e-3, 'VF/VF deep', q), (4, 1, -1e-3, 'VF/VF surface', (1.5, 0.5, 1.0))]
+    assert sorted(v[2] for v in depth_violations(deep, shapes, fixed_mass=held)) == ['VF/VF deep', 'VF/VF surface']
+
+
 # ================================================================ seeded runs
 
 @functools.lru_cache(maxsize=None)
@@ -216,14 +243,16 @@ def recorded_run(kind, seed, side, steps):
     and energy tests read one run. Leaves O reset."""
     O.reset()
     case = case_of(kind, seed, side)
-    ids, _, free = R.build_scene(case, dt=DT, startFromRest=False)
+    ids, fixed, free = R.build_scene(case, dt=DT, startFromRest=False)
     start = R.rest_account(free)
     shapes = R.snapshot(ids)          # the first step's start
+    held = R.FixedMass({i: shapes[i] for i in fixed})   # held blocks never move
     steps_seen = []
     for step in range(1, steps + 1):
         O.step()
-        contacts = [(c.id1, c.id2, c.gap, '%s/%s %s' % (c.kind, c.type, c.state)) for c in yade_dda.contacts()]
-        violations = depth_violations(contacts, shapes)
+        contacts = [(c.id1, c.id2, c.gap, '%s/%s %s' % (c.kind, c.type, c.state), tuple(c.point))
+                    for c in yade_dda.contacts()]
+        violations = depth_violations(contacts, shapes, fixed_mass=held)
         steps_seen.append(dict(step=step, contacts=len(contacts), violations=len(violations),
                                worst=violations[:3], deepest=max([-c[2] for c in contacts] + [0.0]),
                                energy=dict(yade_dda.stats()['energy'])))
@@ -249,10 +278,12 @@ def test_no_sub_contact_is_deeper_than_its_pairs_exact_overlap(scene, kind, seed
                                            worst[2], worst[3], worst[4], worst[5]))
         if excess > KNOWN_EXCESS:
             pytest.fail(message)
-        # Open: sub-micrometre excesses, most where the exact separation comes
-        # from an edge pair the narrow phase treats as parallel (within its
-        # angle tolerance), some on kept contacts of flush joints (up to 5.5e-7 m
-        # on oblique seed 1). Reported, never beyond KNOWN_EXCESS.
+        # Open: excesses of a tenth of a micrometre (up to 1.4e-7 m in the
+        # default runs), on pairs of the EEp and VV types, where the exact
+        # separation comes from an edge pair the narrow phase treats as
+        # parallel (within its angle tolerance) and a corner stands for the
+        # edges' contact along the entrance face. Reported, never beyond
+        # KNOWN_EXCESS.
         pytest.xfail(message)
 
 
