@@ -36,9 +36,15 @@ namespace {
 // move: it slides on the same contacts in the same direction under the same
 // forces, by a dt^2 / 2 each step, where an approach to an equilibrium
 // shrinks the moves by about 1e-3 a step (settlingTimeStep). So a stage
-// gives up once a step above the quiet level moves the blocks by the same
-// amount, within kSettleSteady, as the step before (a cube on a 30 deg slope
-// with 20 deg of friction: 3.965e-5, 3.930e-5 m, then the same to 4 digits).
+// gives up once a step moves the blocks by more than the first locked step
+// did and by the same amount, within kSettleSteady, as the step before (a
+// cube on a 30 deg slope with 20 deg of friction: 21 to 128 times the first
+// move, 3.965e-5, 3.930e-5 m, then the same to 4 digits). A move below the
+// first is a creep of a mechanism driven by a few 1e-5 of its weight (with
+// 2 m / dt^2 = 1e-3 kn a step moves a free mode by 1000 R / kn against the
+// settlement m g / kn): not a block that must slide. A 6 m cube cut by
+// three oblique sets (88 free blocks) repeated such a move, 1.164e-7 m at
+// 1.8e-2 of its first, in its locked stage.
 // The jointed cube above, on its way to rest, moved by amounts going up and
 // down by factors of 2 to 40 from step to step (1e-6 to 6e-5 m in its
 // friction stage's first 30 steps). The old rule, giving up when a step
@@ -171,7 +177,7 @@ bool World::settlingSteps(const IntegratorSettings& statics, double longest, dou
 	// x `reference` (the first step's displacement when reference < 0, which
 	// then sets it) or kSettleQuietSteps in a row each by no more than
 	// kSettleQuiet x `reference`, at most kSettleSteps; false when neither
-	// happens, when a step above the quiet level repeats the move of the one
+	// happens, when a step larger than the first repeats the move of the one
 	// before within kSettleSteady (a block that must slide), when a step has
 	// no static solution, or when nothing settles.
 	int quiet = 0;
@@ -197,7 +203,7 @@ bool World::settlingSteps(const IntegratorSettings& statics, double longest, dou
 		if (moved <= kSettleTolerance * reference) return true;
 		quiet = moved <= kSettleQuiet * reference ? quiet + 1 : 0;
 		if (quiet >= kSettleQuietSteps) return true;
-		if (!quiet && previous > 0 && std::abs(moved - previous) <= kSettleSteady * previous) return false;
+		if (moved > reference && std::abs(moved - previous) <= kSettleSteady * previous) return false;
 		previous = moved;
 	}
 	return false;
