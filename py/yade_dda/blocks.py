@@ -49,6 +49,8 @@ def _finiteNonNegative(value, what, unit):
 
 
 def _points(vertices):
+    if hasattr(vertices, 'corners') and not hasattr(vertices, '__len__'):
+        vertices = vertices.corners   # a RockBlock of cutRockMass: its corners
     try:
         items = list(vertices)
     except TypeError:
@@ -142,7 +144,8 @@ def ddaBlock(vertices, material=None, fixed=False, color=None, velocity=(0, 0, 0
     material's density. The body carries a ``Polyhedra`` shape, so YADE's GUI,
     VTK export and ``O.bodies`` see it like any polyhedron.
 
-    :param vertices: corner points [m], at least 4, not coplanar.
+    :param vertices: corner points [m], at least 4, not coplanar; or a
+        ``RockBlock`` of ``cutRockMass``, taken as its ``corners``.
     :param material: a ``PolyhedraMat`` (or other elastic material with
         ``young`` [Pa], ``poisson`` and ``density`` [kg/m^3]), its id in
         ``O.materials`` or its label; None makes a default ``PolyhedraMat``.
@@ -200,7 +203,7 @@ def ddaBlock(vertices, material=None, fixed=False, color=None, velocity=(0, 0, 0
         points = [points[i] for i in _core.hullCorners(points)]
     o = _options(material, fixed, rigid, velocity, angularVelocity, fixedPoints, loads, stress, mask, color,
                  cohesion, tensileStrength)
-    _core.checkBlock(points, *o.constants)
+    _checkCorners(points, o.constants, hull)
     _requireYadeSize(points)
     body, corners, yadePoints, shift = _body(points, hull, dict(fixed=fixed, wire=wire, color=o.color,
                                                                  material=o.material, mask=mask))
@@ -212,6 +215,23 @@ def ddaBlock(vertices, material=None, fixed=False, color=None, velocity=(0, 0, 0
     spec = BlockSpec(points=yadePoints, shift=shift, **o.spec())
     _scene.current().register(body, spec)
     return body
+
+
+_NOT_A_CORNER = ('strictly inside the hull', 'on the hull surface but is not a corner')
+"""The core's refusals (ConvexPolyhedron.cpp) of a point that is no corner of the points' convex hull."""
+
+
+def _checkCorners(points, constants, hull):
+    """The core's check of a block's corners; where a point is no corner of the hull (concave points,
+    e.g. an L's), the refusal also names the ways out: concaveBlock, and hull=True."""
+    try:
+        _core.checkBlock(points, *constants)
+    except ValueError as error:
+        if hull or not any(text in str(error) for text in _NOT_A_CORNER):
+            raise
+        raise ValueError('%s. These points are not the corners of a convex polyhedron: for a concave block use '
+                         'concaveBlock(parts) (convex parts) or concaveBlock(surface=(points, triangles)); for the '
+                         'convex hull of the points pass ddaBlock(..., hull=True)' % error) from None
 
 
 class _Options:

@@ -21,7 +21,7 @@ from . import guards as _guards
 from . import params as _settings
 from . import scene as _scene
 from .guards import COLLIDER_COMMAND
-from .params import Engine, Parameter, finite, initEngine
+from .params import Engine, Parameter, finite, initEngine, keywordsOnly
 
 
 def _select(name, **parameters):
@@ -47,8 +47,11 @@ class _ColliderEngine(Engine, wrapper.PyRunner):
 
     _strategy = None
     _names = ()
+    _periodAdvice = ('; it chooses the broad phase for the iteration it runs in, and DESS and MSC already reuse '
+                     'their candidate pairs while no block left its allowance (DDAIntegrator.reuseCandidatePairs)')
 
-    def __init__(self, label='', **params):
+    def __init__(self, *args, label='', **params):
+        keywordsOnly(type(self), args)
         wrapper.PyRunner.__init__(self)
         initEngine(self, label, params)
 
@@ -167,13 +170,14 @@ class MSCCollider(_ColliderEngine):
     criticalLength = Parameter(0.0, _criticalLength, 'lambda [m]: edges longer than this are divided; 0 = 3 x block size')
     segments = Parameter(3, _segments, 'N: segments per divided edge')
 
-    def __init__(self, label='', **params):
+    def __init__(self, *args, label='', **params):
+        keywordsOnly(type(self), args)
         if 'MSC' not in _settings.COLLIDERS:
             raise NotImplementedError(
                 'MSCCollider: the multi-shell cover collider is not in this build of the DDA core yet '
                 '(available broad phases: %s). Use DESSCollider (same contacts) until it is.'
                 % ', '.join(_settings.COLLIDERS))
-        _ColliderEngine.__init__(self, label, **params)
+        _ColliderEngine.__init__(self, label=label, **params)
 
 
 def available():

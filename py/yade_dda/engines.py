@@ -16,7 +16,7 @@ from . import guards as _guards
 from . import scene as _scene
 from .hooks import USER_DT_TAG, writeDt
 from .state import tag
-from .params import Engine, Parameter, RULES, SETTINGS, initEngine, parameterLine
+from .params import Engine, Parameter, RULES, SETTINGS, initEngine, keywordsOnly, parameterLine
 
 
 _INTEGRATOR_DOC = """Shi's implicit DDA time integration of all DDA blocks, with their contacts
@@ -48,6 +48,17 @@ _INTEGRATOR_DOC = """Shi's implicit DDA time integration of all DDA blocks, with
 
         O.engines = [DDAIntegrator(dt=1e-3, gravity=(0, 0, -9.81), label='dda')]
         O.run(1000, True)
+
+    Keyword arguments only, as every YADE engine takes them: ``DDAIntegrator(1e-3)`` is a TypeError
+    that says to write ``DDAIntegrator(dt=0.001, ...)``. A positional dt is not accepted because no YADE
+    engine reads one, and the positional arguments of ``PyRunner``, whose subclass this is, are
+    ``iterPeriod`` and ``command``: a script written as for a PyRunner must not be read as a time step.
+
+    It runs at every iteration: ``iterPeriod`` is fixed at 1 (``virtPeriod`` and ``realPeriod`` at 0,
+    ``nDo`` at -1), given here or assigned later, because YADE advances ``O.time`` by ``O.dt`` at every
+    iteration whether the engine ran or not. For longer steps raise ``dt``; to write YADE's bodies less
+    often set ``syncPeriod``; for work every n iterations add a ``PyRunner(iterPeriod=n, command=...)``;
+    ``dead = True`` stops it.
     """ % (RULES, '\n'.join(textwrap.fill(parameterLine(row), 79, initial_indent='    - ', subsequent_indent='      ')
                                for row in SETTINGS))
 
@@ -55,8 +66,12 @@ _INTEGRATOR_DOC = """Shi's implicit DDA time integration of all DDA blocks, with
 class DDAIntegrator(Engine, wrapper.PyRunner):
     __doc__ = _INTEGRATOR_DOC
     _names = tuple(row['name'] for row in SETTINGS)
+    _periodAdvice = ('; it takes one DDA step per iteration: for longer steps raise dt, to write the YADE bodies '
+                     'less often set syncPeriod=n, for work every n iterations add a PyRunner(iterPeriod=n, '
+                     'command=...)')
 
-    def __init__(self, label='', **params):
+    def __init__(self, *args, label='', **params):
+        keywordsOnly(type(self), args)
         wrapper.PyRunner.__init__(self)
         initEngine(self, label, params)
 

@@ -171,23 +171,47 @@ class Engine:
                 self._checkPeriod(name, value)
         super().__setattr__(name, value)
 
+    _periodAdvice = ''
+    """What to use instead of a period, appended to the refusal (an engine class's own)."""
+
     def _checkPeriod(self, name, value):
         if value != {'iterPeriod': 1, 'nDo': -1}.get(name, 0):
             raise ValueError(
                 '%s runs at every iteration: %s = %r would let O.time advance by O.dt at iterations where it '
-                'does not run (iterPeriod must be 1, virtPeriod and realPeriod 0, nDo -1); set dead = True '
-                'to stop it' % (type(self).__name__, name, value))
+                'does not run (iterPeriod is fixed at 1, virtPeriod and realPeriod at 0, nDo at -1); set dead = '
+                'True to stop it%s' % (type(self).__name__, name, value, self._periodAdvice))
 
     def _setYade(self, name, value):
         """Sets YADE's engine attribute `name` without the checks (the engine's own bookkeeping)."""
         super().__setattr__(name, value)
 
 
+def keywordsOnly(cls, args):
+    """Refuses positional arguments to engine class `cls` with a TypeError naming the keyword to write.
+    YADE's engines take keyword arguments only (PyRunner's positional ones are iterPeriod and command, which
+    ours set themselves), so ``DDAIntegrator(1e-3)`` is refused rather than read as dt or as the label."""
+    if not args:
+        return
+    first, names = args[0], cls._names
+    if isinstance(first, str) and not (names and isinstance(getattr(cls, names[0]).default, str)):
+        hint = '; write %s(label=%r, ...)' % (cls.__name__, first)
+    elif names:
+        hint = '; write %s(%s=%r, ...)' % (cls.__name__, names[0], first)
+    else:
+        hint = ''
+    raise TypeError("%s takes keyword arguments only, as YADE's engines do: got the positional argument%s %s%s "
+                    "(its parameters: %s)" % (cls.__name__, 's' if len(args) > 1 else '', ', '.join(map(repr, args)),
+                                              hint, ', '.join(names) or 'none but label'))
+
+
 def initEngine(engine, label, params):
     """Checks and stores an engine's typed parameters (its class's ``_names``,
     each a Parameter), runs it every step from the first, sets the label and
-    writes the command. Unknown names raise TypeError naming them."""
+    writes the command. Unknown names raise TypeError naming them; YADE's
+    periods (iterPeriod, virtPeriod, realPeriod, nDo) are checked by the
+    engine's ``_checkPeriod``, as when assigned, and set."""
     names = type(engine)._names
+    periods = {name: params.pop(name) for name in _PERIODS if name in params}
     unknown = set(params) - set(names)
     if unknown:
         near = sorted({m for name in unknown for m in difflib.get_close_matches(name, names, 2)})
@@ -199,6 +223,8 @@ def initEngine(engine, label, params):
     for name in names:
         descriptor = type(engine).__dict__[name]
         engine._params[name] = descriptor.check(params.get(name, descriptor.default))
+    for name, value in periods.items():
+        engine._checkPeriod(name, value)
     if not isinstance(label, str):
         raise TypeError('label must be a string, got %r' % (label,))
     engine._setYade('iterPeriod', 1)
@@ -206,6 +232,8 @@ def initEngine(engine, label, params):
     if label:
         engine.label = label
     engine._updateCommand()
+    for name, value in periods.items():
+        setattr(engine, name, value)
 
 
 COLLIDERS = tuple(_core.colliderNames())

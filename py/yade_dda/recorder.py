@@ -44,7 +44,7 @@ import numpy
 from ._yade import O, wrapper
 from . import scene as _scene
 from .guards import INTEGRATOR_COMMAND
-from .params import Engine, Parameter, finite, initEngine, integer
+from .params import Engine, Parameter, finite, initEngine, integer, keywordsOnly
 
 
 CONTACT_STATES = {'open': 0, 'sliding': 1, 'locked': 2}
@@ -135,7 +135,8 @@ class DDAVTKRecorder(Engine, wrapper.PyRunner):
 
     _names = ('fileName',)
 
-    def __init__(self, label='', **params):
+    def __init__(self, *args, label='', **params):
+        keywordsOnly(type(self), args)
         known = self._names + _PERIODS
         unknown = sorted(set(params) - set(known))
         if unknown:

@@ -36,7 +36,7 @@ import warnings
 
 from ._yade import O, wrapper
 from . import scene as _scene
-from .params import Engine, Parameter, initEngine, integer
+from .params import Engine, Parameter, initEngine, integer, keywordsOnly
 from .scene import restoreState
 from .state import FORMAT, STATE_TAG, decodeState, encodeState, tag  # noqa: F401  (part of saveload's API)
 
@@ -213,7 +213,8 @@ class Checkpoint(Engine, wrapper.PyRunner):
 
     _names = ('period', 'directory', 'name', 'keep', 'format')
 
-    def __init__(self, label='', **params):
+    def __init__(self, *args, label='', **params):
+        keywordsOnly(type(self), args)
         wrapper.PyRunner.__init__(self)
         initEngine(self, label, params)
         self._setYade('initRun', False)

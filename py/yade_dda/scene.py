@@ -282,7 +282,9 @@ def stats():
     Keys: ``dt`` [s] taken, ``stepCuts`` (redos with a smaller dt in that step,
     for either reason below), ``displacementLimitMisses`` (cumulative steps
     accepted above the bound), ``maxDisplacement`` and ``allowedDisplacement``
-    [m], ``blocks``, ``movingBlocks``, ``unknowns`` (system size: 12 per
+    [m], ``blocks`` (DDA blocks: a concave block counts once), ``parts``
+    (their convex parts: a concave block's each), ``movingBlocks``,
+    ``unknowns`` (system size: 12 per
     moving block, 6 per rigid one), ``rigidBlocks`` (moving rigid blocks),
     ``strainUnknowns`` (6 per deformable moving block), ``solvedUnknowns``
     (unknowns the last solve factorised, counted by the solver: equals
@@ -353,6 +355,8 @@ def stats():
     """
     scene = _require()
     result = scene.core.lastStep()
+    result['parts'] = result['blocks']   # the core counts convex parts
+    result['blocks'] = _blockCount(scene, result['parts'])
     result['time']['sync'] = scene.syncTime
     result['time']['syncBodies'] = scene.syncParts['bodies']
     result['time']['syncViews'] = scene.syncParts['views']
@@ -365,6 +369,16 @@ def stats():
     result['collider'] = scene.core.collider()
     result['effects'] = _effects(result)
     return result
+
+
+def _blockCount(scene, parts):
+    """The DDA blocks among the core's first `parts` convex parts (a concave block's parts follow its
+    first, which is its body: core.bodyOf), cached per core and part count (parts are only appended)."""
+    cached = getattr(scene, 'blockCountCache', None)
+    if cached is None or cached[0] is not scene.core or cached[1] != parts:
+        bodyOf = scene.core.bodyOf
+        cached = scene.blockCountCache = (scene.core, parts, sum(1 for i in range(parts) if bodyOf(i) == i))
+    return cached[2]
 
 
 def _effects(s):
@@ -383,8 +397,9 @@ def _effects(s):
 def printStats():
     """Prints the last step's diagnostics as a table."""
     s = stats()
-    print('DDA step: dt %.3e s, %d cuts, %d/%d moving blocks, %d unknowns, max displacement %.3e m (allowed %.3e m)'
-          % (s['dt'], s['stepCuts'], s['movingBlocks'], s['blocks'], s['unknowns'], s['maxDisplacement'],
+    parts = ' (%d parts)' % s['parts'] if s['parts'] != s['blocks'] else ''
+    print('DDA step: dt %.3e s, %d cuts, %d/%d moving blocks%s, %d unknowns, max displacement %.3e m (allowed %.3e m)'
+          % (s['dt'], s['stepCuts'], s['movingBlocks'], s['blocks'], parts, s['unknowns'], s['maxDisplacement'],
              s['allowedDisplacement']))
     print('  contacts: %d pairs of %d candidates, %d sub-contacts (%d closed, %d sliding), '
           '%d open-close iterations, %d cuts, max penetration %.3e m'

@@ -213,6 +213,20 @@ def test_cube_far_from_origin_of_the_issue_steps(scene):
     assert bijective and err < 16 * EPS * 2e5
 
 
+def test_a_rock_block_is_accepted_as_its_corners(scene):
+    """ddaBlock(rockBlock) was refused ("vertices must be a sequence of points"): a RockBlock of
+    cutRockMass is taken as its .corners, by ddaBlock and rigidBlock alike."""
+    mass = yade_dda.cutRockMass(box((0, 0, 0), (2, 2, 2)), [dict(dip=0, dipDirection=0, spacing=1, origin=(0, 0, 1))])
+    assert len(mass) == 2
+    bodies = [O.bodies.append(ddaBlock(mass[0])), O.bodies.append(yade_dda.rigidBlock(mass[1]))]
+    O.engines = [DDAIntegrator(dt=1e-3, label='dda')]
+    O.step()
+    for body, rock in zip(bodies, mass):
+        assert sorted(tuple(v) for v in yade_dda.block(body).vertices) == sorted(tuple(p) for p in rock.corners)
+        assert abs(yade_dda.block(body).volume - rock.volume) < 1e-12
+    assert yade_dda.block(bodies[1]).rigid
+
+
 def test_far_body_vertices_of_another_shape_are_refused(scene):
     """The link still refuses a body whose corners are not the block's, naming vertex, distance and tolerance."""
     body = ddaBlock(box((1e6, 1e6, 0), (1e6 + 1, 1e6 + 1, 1)))

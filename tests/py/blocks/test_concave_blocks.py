@@ -225,6 +225,23 @@ def test_bad_parts_are_refused_naming_the_problem(scene):
         O.step()
 
 
+def test_stats_and_print_stats_count_blocks_not_parts(scene, capsys):
+    """printStats() said "16/70 moving blocks" for 28 blocks: stats()['blocks'] counted a concave block's
+    parts. It counts DDA blocks (as movingBlocks and fixedBlocks do); stats()['parts'] counts the parts."""
+    rock = material(O)
+    O.bodies.append(ddaBlock(box((-5, -5, -2), (5, 5, -1)), material=rock, fixed=True))
+    O.bodies.appendClumped(concaveBlock(l_parts(), material=rock))
+    O.bodies.appendClumped(concaveBlock(l_parts((3.0, 0.0, 0.0)), material=rock))
+    O.bodies.append(ddaBlock(cube((-3.0, 0.0, 0.0)), material=rock))
+    O.engines = [DDAIntegrator(dt=1e-3, gravity=(0, 0, -G))]
+    O.step()
+    s = yade_dda.stats()
+    assert (s['blocks'], s['movingBlocks'], s['fixedBlocks'], s['parts']) == (4, 3, 1, 8)
+    assert s['unknowns'] == 12 * 3
+    yade_dda.printStats()
+    assert '3/4 moving blocks (8 parts)' in capsys.readouterr().out
+
+
 def test_staggered_bricks_are_split_so_that_shared_faces_match(scene):
     """Two bricks staggered by half a length share half of each top/bottom face: the upper is split along
     the lower's end face, so the block has three parts (three members), the volume of the two bricks and

@@ -75,6 +75,32 @@ def test_bad_block_geometry(scene, points, match):
     refused(ValueError, match, lambda: ddaBlock(points))
 
 
+L_PRISM = [(x, y, z) for (x, y) in [(0, 0), (2, 0), (2, 1), (1, 1), (1, 2), (0, 2)] for z in (0, 1)]
+
+
+@pytest.mark.parametrize('points, match', [
+    (L_PRISM, r'point 6 .* on the hull surface but is not a corner'),
+    (UNIT + [(0.5, 0.5, 0.9)], r'point 8 .* strictly inside the hull'),
+    (UNIT + [(0.5, 0.5, 1 - 1e-12)], r'point 8 .* not a corner: it is inside a face'),
+], ids=['L prism', 'dent', 'dent within the tolerance'])
+def test_concave_points_name_concave_block_and_hull(scene, points, match):
+    """A concave point list (an L's corners) got "... the block is too flat there" without a word of
+    the ways out: the message names concaveBlock(...) and hull=True."""
+    refused(ValueError, match, lambda: ddaBlock(points))
+    with pytest.raises(ValueError) as error:
+        ddaBlock(points)
+    message = str(error.value)
+    assert 'not the corners of a convex polyhedron' in message, message
+    assert 'concaveBlock(' in message and 'hull=True' in message, message
+
+
+def test_flat_points_get_no_concave_hint(scene):
+    """Points that are flat, not concave: hull=True or concaveBlock would not help, so neither is named."""
+    with pytest.raises(ValueError) as error:
+        ddaBlock(box((0, 0, 0), (1, 1, 1e-10)))
+    assert 'too flat' in str(error.value) and 'concaveBlock' not in str(error.value)
+
+
 def test_tiny_block_far_from_origin_is_rejected_not_an_internal_error(scene):
     """Fuzz finding: a 1e-16 m tetrahedron 6e-6 m from the origin raised buildConvexPolyhedron's
     internal error ('input point outside its own hull'); now a clear ValueError."""

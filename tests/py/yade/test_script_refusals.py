@@ -82,6 +82,40 @@ def test_an_engine_that_must_run_every_iteration_refuses_a_period(scene, make, n
     assert (engine.iterPeriod, engine.virtPeriod, engine.realPeriod, engine.nDo) == before == (1, 0, 0, -1)
 
 
+@pytest.mark.parametrize('name, value', [('iterPeriod', 2), ('iterPeriod', 0), ('virtPeriod', 1e-3),
+                                         ('realPeriod', 1.0), ('nDo', 10)])
+def test_a_period_given_to_the_integrator_says_it_runs_every_iteration(scene, name, value):
+    """DDAIntegrator(iterPeriod=2) answered "did you mean syncPeriod?": a period given to the constructor
+    gets the same refusal as one assigned later, with what to use instead."""
+    with pytest.raises(ValueError, match='DDAIntegrator runs at every iteration: %s = ' % name) as error:
+        yade_dda.DDAIntegrator(dt=1e-3, **{name: value})
+    message = str(error.value)
+    assert 'iterPeriod is fixed at 1' in message and 'syncPeriod' in message and 'dead = True' in message
+    assert 'did you mean' not in message
+    with pytest.raises(ValueError, match='DESSCollider runs at every iteration: iterPeriod = 2'):
+        yade_dda.DESSCollider(iterPeriod=2)
+    assert yade_dda.DDAIntegrator(iterPeriod=1).iterPeriod == 1   # what it is anyway
+
+
+@pytest.mark.parametrize('make, match', [
+    (lambda: yade_dda.DDAIntegrator(1e-3), r'DDAIntegrator takes keyword arguments only, as YADE\'s engines do: '
+                                           r'got the positional argument 0.001; write DDAIntegrator\(dt=0.001, \.\.\.\)'),
+    (lambda: yade_dda.DDAIntegrator(1e-3, (0, 0, -9.81)), r'got the positional arguments 0.001, \(0, 0, -9.81\); '
+                                                          r'write DDAIntegrator\(dt=0.001, \.\.\.\)'),
+    (lambda: yade_dda.DDAIntegrator('dda'), r"write DDAIntegrator\(label='dda', \.\.\.\)"),
+    (lambda: yade_dda.MSCCollider(2.0), r'MSCCollider takes keyword arguments only.*MSCCollider\(criticalLength=2.0'),
+    (lambda: yade_dda.DESSCollider(3), r'DESSCollider takes keyword arguments only.*its parameters: none but label'),
+    (lambda: yade_dda.Checkpoint(100), r'Checkpoint takes keyword arguments only.*Checkpoint\(period=100'),
+], ids=['dt', 'dt and gravity', 'label', 'MSCCollider', 'DESSCollider', 'Checkpoint'])
+def test_a_positional_argument_is_refused_naming_the_keyword(scene, make, match):
+    """DDAIntegrator(1e-3) said "label must be a string". YADE engines take keyword arguments only
+    (PyRunner's positional ones are iterPeriod and command), so a positional one is a TypeError that
+    says which keyword to write."""
+    with pytest.raises(TypeError, match=match) as error:
+        make()
+    assert 'label must be a string' not in str(error.value)
+
+
 def test_iteration_period_2_would_have_let_time_run_ahead(scene):
     """Why the period is refused: with YADE's own attribute forced to 2 past our check, O.time
     advances by O.dt at every iteration while the block moves at every other one (a free fall
