@@ -44,11 +44,11 @@ namespace {
 // 2 m / dt^2 = 1e-3 kn a step moves a free mode by 1000 R / kn against the
 // settlement m g / kn): not a block that must slide. A 6 m cube cut by
 // three oblique sets (88 free blocks) repeated such a move, 1.164e-7 m at
-// 1.8e-2 of its first, in its locked stage.
-// The jointed cube above, on its way to rest, moved by amounts going up and
-// down by factors of 2 to 40 from step to step (1e-6 to 6e-5 m in its
-// friction stage's first 30 steps). The old rule, giving up when a step
-// moved more than half the one before, gave that cube up at the second
+// 1.8e-2 of its first, in its locked stage, and settled later. Nor can the
+// rule ask the moves to shrink: the 5 m cube above, on its way to rest,
+// moved by amounts going up and down by factors of 2 to 40 from step to
+// step (1e-6 to 6e-5 m in its friction stage's first 30 steps); giving up
+// when a step moves more than half the one before gives it up at its second
 // step. Energy: the settling is an initial condition (see settle); the
 // account starts from the state reached.
 constexpr double kSettleFrictionScale = 1e6;
