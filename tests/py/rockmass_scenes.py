@@ -14,12 +14,13 @@ Oracles that need no stored answer (each a closed form of the drawn scene):
 - the energy account balances;
 - no sub-contact is deeper than the exact overlap of its two blocks
   (`separation` below: numpy's separating-axis value, independent of the
-  core's narrow phase);
+  core's narrow phase), or a free block's corner on a held block than the
+  corner lies in the held mass (`FixedMass`);
 - every collider gives the all-pairs contact set; 1 and 2 threads give the
   same bits.
 
-`draw_case`, `Convex`, `separation`, `penetration` and `depth_violations` are
-plain Python plus numpy; `build_scene`, `snapshot`, `exact_penetration` and
+`draw_case`, `Convex`, `separation`, `penetration`, `FixedMass` and
+`depth_violations` are plain Python plus numpy; `build_scene`, `snapshot`, `exact_penetration` and
 `rest_account` need YADE.
 """
 import math
