@@ -165,6 +165,13 @@ py::list contactGaps(const SceneLink& s) {
 	return out;
 }
 
+// World::unsettledBlocks as a Python list of block indices.
+py::list unsettledBlocks(const SceneLink& s) {
+	py::list out;
+	for (int b : s.world.unsettledBlocks()) out.append(b);
+	return out;
+}
+
 // The narrow phase of one pair of blocks at their current geometry, as the
 // integrator would see it with contact distance d0 [m]: None when farther
 // apart, else (structural type, entrance normal, [(kind, i owns, feature of
@@ -486,6 +493,8 @@ void registerScene() {
 	          py::arg("cohesion"), py::arg("tensileStrength"), py::arg("fixed"), py::arg("rigid") = false))
 	    .def("contacts", &contactList)
 	    .def("contactGaps", &contactGaps, "Gap [m] at the start of the last step of each sub-contact, as in contacts().")
+	    .def("unsettledBlocks", &unsettledBlocks,
+	         "Block indices still moving when a stage of the start from rest gave up (World::unsettledBlocks).")
 	    .def("setCollider", &setCollider)
 	    .def("setCover", &setCover)
 	    .def("detectPair", &detectPair)

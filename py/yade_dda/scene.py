@@ -316,7 +316,11 @@ def stats():
     ``settleSteps``, ``settledBlocks``, ``settleConverged``: the start from
     rest before the first step (DDAIntegrator's startFromRest): static steps
     made (0: nothing to settle), blocks brought to equilibrium, and whether
-    it converged (else the scene started as placed).
+    it converged (else the scene started as placed); ``unsettledBlocks``, the
+    body ids still moving when a stage gave up: the blocks no equilibrium with
+    friction locked holds (then ``settleConverged`` is False and the scene
+    started as placed), or those friction at its true value cannot hold (a
+    block that must slide: the locked state was kept); empty when it settled.
     ``energy``: the energy account [J], each term from its own formula:
     ``kinetic``, ``gravity`` (potential of the last step's gravity),
     ``strain``, ``contact`` (springs of the closed contacts), and summed over
@@ -367,6 +371,7 @@ def stats():
     result['pendingBodies'] = sum(1 for body, _ in scene.pending if body.id >= 0)
     result['steps'] = scene.core.steps()
     result['collider'] = scene.core.collider()
+    result['unsettledBlocks'] = sorted({scene.bodyOfBlock[b] for b in scene.core.unsettledBlocks()})
     result['effects'] = _effects(result)
     return result
 

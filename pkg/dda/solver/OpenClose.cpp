@@ -366,6 +366,20 @@ double OpenCloseIteration::largestDisplacement(const std::vector<Block>& blocks)
 	return largest;
 }
 
+void OpenCloseIteration::blocksMovedMoreThan(const std::vector<Block>& blocks, double threshold,
+                                             std::vector<int>& out) const {
+	out.clear();
+	for (std::size_t k = 0; k < moving_.size(); ++k) {
+		const Block& body = blocks[moving_[k]];
+		double moved = largestVertexDisplacement(body, solutions_[k]);
+		for (int p = 1; p < body.partCount; ++p)
+			moved = std::max(moved, largestVertexDisplacement(blocks[moving_[k] + p].vertices, body.centroid,
+			                                                  solutions_[k]));
+		if (moved > threshold) out.push_back(moving_[k]);
+	}
+	std::sort(out.begin(), out.end());
+}
+
 StepShrink OpenCloseIteration::smallestJacobian(const std::vector<Block>& blocks) const {
 	StepShrink smallest;
 	for (std::size_t k = 0; k < moving_.size(); ++k) {

@@ -42,6 +42,9 @@ public:
 	const Vector12& solutionOf(int block) const;
 	// Largest vertex displacement of the last attempt [m].
 	double largestDisplacement(const std::vector<Block>& blocks) const;
+	// The moving blocks (block indices, ascending) whose corners the last
+	// solution moves by more than `threshold` [m].
+	void blocksMovedMoreThan(const std::vector<Block>& blocks, double threshold, std::vector<int>& out) const;
 	// The smallest stepJacobian over the moving blocks, and that block.
 	StepShrink smallestJacobian(const std::vector<Block>& blocks) const;
 	// Whether the solver keeps work between solves (World::setSolverReuse).

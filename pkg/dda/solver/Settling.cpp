@@ -150,6 +150,7 @@ void World::settle(const IntegratorSettings& settings) {
 	frozen_.clear();
 	settleSteps_ = 0;
 	settleConverged_ = false;
+	unsettled_.clear();
 	double first = -1;
 	settleConverged_ = settlingSteps(statics, longest, first);
 	if (settleConverged_) admitFriction(statics, longest, first);
@@ -200,9 +201,16 @@ bool World::settlingSteps(const IntegratorSettings& statics, double longest, dou
 		const double moved = stats_.maxDisplacement;
 		if (reference < 0) reference = moved;
 		if (settledBlocks_ == 0) return false;
-		if (moved <= kSettleTolerance * reference) return true;
+		if (moved <= kSettleTolerance * reference) {
+			unsettled_.clear();
+			return true;
+		}
 		quiet = moved <= kSettleQuiet * reference ? quiet + 1 : 0;
-		if (quiet >= kSettleQuietSteps) return true;
+		if (quiet >= kSettleQuietSteps) {
+			unsettled_.clear();
+			return true;
+		}
+		openClose_.blocksMovedMoreThan(blocks_, kSettleQuiet * reference, unsettled_);
 		if (moved > reference && std::abs(moved - previous) <= kSettleSteady * previous) return false;
 		previous = moved;
 	}

@@ -93,6 +93,12 @@ public:
 	long steps() const { return steps_; }
 	// Sub-contacts of the last step, with their state at its end.
 	const std::vector<Contact>& contacts() const { return store_.contacts(); }
+	// Start from rest: the blocks (indices, ascending) still moving by more
+	// than the quiet level at the last static step of a stage that gave up:
+	// the locked stage (the scene starts as placed) or the stage with the
+	// true friction (the locked state is kept; these blocks cannot be held by
+	// friction). Empty when the settling converged; not saved.
+	const std::vector<int>& unsettledBlocks() const { return unsettled_; }
 	// The broad phase (DESSCollider unless set).
 	void setCollider(std::unique_ptr<Collider> collider);
 	const Collider& collider() const { return *collider_; }
@@ -154,6 +160,7 @@ private:
 	bool settleTried_ = false;
 	int settleSteps_ = 0, settledBlocks_ = 0;
 	bool settleConverged_ = false;
+	std::vector<int> unsettled_;  // see unsettledBlocks()
 
 	// Adds the accepted step's dissipation, work of loads and contact springs'
 	// changes to the account (energy_), and records the springs' energy at its

@@ -146,6 +146,42 @@ def test_block_without_equilibrium_starts_as_placed(scene):
     assert runs[True] == runs[False]
 
 
+def test_settling_names_the_blocks_it_cannot_hold(scene):
+    """stats()['unsettledBlocks']: beside a cube on a floor (held), a cube on a 30 deg
+    incline with 20 deg of friction (must slide: the locked state is kept, the
+    settling converged) and, in a second scene, a cube on a frictionless 20 deg slope
+    (no equilibrium even locked: started as placed) are named; a held cube is not."""
+    rock = O.materials.append(wrapper.PolyhedraMat(density=2600, young=1e10, poisson=0.25,
+                                                   frictionAngle=math.radians(20)))
+    a = math.radians(30)
+    up = (math.cos(a), 0, math.sin(a))      # the incline's frame: x up the slope, normal (-sin a, 0, cos a)
+    normal = (-math.sin(a), 0, math.cos(a))
+    def on_incline(x0, sx, sz):
+        return [tuple(x0[i] + u * up[i] + w * normal[i] for i in range(3)) for u in sx for w in sz]
+    slab = [tuple(p[i] + y * (i == 1) for i in range(3)) for p in on_incline((0, 0, 0), (-6, 6), (-1, 0))
+            for y in (-2, 2)]
+    O.bodies.append(yade_dda.ddaBlock(slab, material=rock, fixed=True))
+    cube = [tuple(p[i] + y * (i == 1) for i in range(3)) for p in on_incline((0, 0, 0), (0, 1), (0, 1))
+            for y in (-0.5, 0.5)]
+    sliding = O.bodies.append(yade_dda.ddaBlock(cube, material=rock))
+    O.bodies.append(yade_dda.ddaBlock(box((20, -2, -1), (26, 2, 0)), material=rock, fixed=True))
+    held = O.bodies.append(yade_dda.ddaBlock(box((22, -.5, 0), (23, .5, 1)), material=rock))
+    O.engines = [DDAIntegrator(dt=1e-3, gravity=(0, 0, -G), label='dda')]
+    O.run(1, True)
+    s = yade_dda.stats()
+    assert s['settleConverged'] and s['unsettledBlocks'] == [sliding], (s['settleConverged'], s['unsettledBlocks'])
+    assert held not in s['unsettledBlocks']
+    O.reset()
+    cube = cube_on_floor(slope_deg=20.0, friction_deg=0.0)
+    O.run(1, True)
+    s = yade_dda.stats()
+    assert not s['settleConverged'] and s['unsettledBlocks'] == [cube], s['unsettledBlocks']
+    O.reset()
+    cube = cube_on_floor()
+    O.run(1, True)
+    assert yade_dda.stats()['unsettledBlocks'] == []
+
+
 def test_energy_account_starts_at_the_settled_state(scene):
     """The account starts after the settling: its contact term holds the settled
     springs' energy, N^2/(2 kn) + |S|^2/(2 ks) over the contacts (the deformable
