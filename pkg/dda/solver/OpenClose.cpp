@@ -352,31 +352,28 @@ void OpenCloseIteration::computeStartAccelerations(const Attempt& attempt) {
 	}
 }
 
+double OpenCloseIteration::displacementOf(const std::vector<Block>& blocks, int k) const {
+	const Block& body = blocks[moving_[k]];
+	double largest = largestVertexDisplacement(body, solutions_[k]);
+	for (int p = 1; p < body.partCount; ++p)  // a concave block's other parts, about its centroid
+		largest = std::max(largest,
+		                   largestVertexDisplacement(blocks[moving_[k] + p].vertices, body.centroid, solutions_[k]));
+	return largest;
+}
+
 double OpenCloseIteration::largestDisplacement(const std::vector<Block>& blocks) const {
 	const int n = static_cast<int>(moving_.size());
 	double largest = 0;
 #pragma omp parallel for schedule(static) reduction(max : largest) if (n >= kMinBlocksForThreads)
-	for (int k = 0; k < n; ++k) {
-		const Block& body = blocks[moving_[k]];
-		largest = std::max(largest, largestVertexDisplacement(body, solutions_[k]));
-		for (int p = 1; p < body.partCount; ++p)  // a concave block's other parts, about its centroid
-			largest = std::max(largest, largestVertexDisplacement(blocks[moving_[k] + p].vertices, body.centroid,
-			                                                      solutions_[k]));
-	}
+	for (int k = 0; k < n; ++k) largest = std::max(largest, displacementOf(blocks, k));
 	return largest;
 }
 
 void OpenCloseIteration::blocksMovedMoreThan(const std::vector<Block>& blocks, double threshold,
                                              std::vector<int>& out) const {
 	out.clear();
-	for (std::size_t k = 0; k < moving_.size(); ++k) {
-		const Block& body = blocks[moving_[k]];
-		double moved = largestVertexDisplacement(body, solutions_[k]);
-		for (int p = 1; p < body.partCount; ++p)
-			moved = std::max(moved, largestVertexDisplacement(blocks[moving_[k] + p].vertices, body.centroid,
-			                                                  solutions_[k]));
-		if (moved > threshold) out.push_back(moving_[k]);
-	}
+	for (int k = 0; k < static_cast<int>(moving_.size()); ++k)
+		if (displacementOf(blocks, k) > threshold) out.push_back(moving_[k]);
 	std::sort(out.begin(), out.end());
 }
 

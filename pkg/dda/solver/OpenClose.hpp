@@ -56,6 +56,8 @@ public:
 	std::size_t memoryBytes() const;
 
 private:
+	// The largest displacement [m] of moving block k's corners (all its parts) by its last solution.
+	double displacementOf(const std::vector<Block>& blocks, int k) const;
 	// One attempt's inputs, as solve() was given them.
 	struct Attempt {
 		const std::vector<Block>& blocks;

@@ -331,6 +331,18 @@ def contact_change_gains(start, energies, absolute=1.0, relative=1e-3):
     return out
 
 
+def assert_account_balances(case, start, energies):
+    drifts = account_drifts(start, energies)
+    assert not drifts, '%s: the account drifts at %d steps; first: step %d, %.3g J (largest term %.3g J, largest ' \
+        'change %.3g J)' % ((describe(case), len(drifts)) + drifts[0])
+
+
+def assert_no_contact_change_gain(case, start, energies):
+    gains = contact_change_gains(start, energies)
+    assert not gains, '%s: contact changes added energy at %d steps; largest: step %d, %.3g J (allowed %.3g J)' % (
+        (describe(case), len(gains)) + max(gains, key=lambda g: g[1] - g[2]))
+
+
 def test_energy_checks_flag_a_drift_and_a_gain():
     """account_drifts and contact_change_gains on made-up accounts: a balanced
     exchange of gravity for kinetic energy passes; 5 J appearing from nowhere,
@@ -352,18 +364,14 @@ def test_energy_checks_flag_a_drift_and_a_gain():
 def test_the_energy_account_balances(scene, kind, seed, side, steps):
     case, start, seen = recorded_run(kind, seed, side, steps)
     print(describe(case))
-    drifts = account_drifts(start, [s['energy'] for s in seen])
-    assert not drifts, '%s: the account drifts at %d steps; first: step %d, %.3g J (largest term %.3g J, largest ' \
-        'change %.3g J)' % ((describe(case), len(drifts)) + drifts[0])
+    assert_account_balances(case, start, [s['energy'] for s in seen])
 
 
 @pytest.mark.parametrize('kind, seed, side, steps', RUNS, ids=RUN_IDS)
 def test_contact_changes_add_no_energy(scene, kind, seed, side, steps):
     case, start, seen = recorded_run(kind, seed, side, steps)
     print(describe(case))
-    gains = contact_change_gains(start, [s['energy'] for s in seen])
-    assert not gains, '%s: contact changes added energy at %d steps; largest: step %d, %.3g J (allowed %.3g J)' % (
-        (describe(case), len(gains)) + max(gains, key=lambda g: g[1] - g[2]))
+    assert_no_contact_change_gain(case, start, [s['energy'] for s in seen])
 
 
 # ================================================================ at rest after the start from rest
@@ -413,12 +421,8 @@ def test_a_confined_mass_settles_and_stays_at_rest(scene, kind, seed, side, dura
 @pytest.mark.parametrize('kind, seed, side, duration', REST_RUNS)
 def test_a_settled_mass_keeps_its_energy_account(scene, kind, seed, side, duration):
     case, first, _, energies, _, _, _ = rest_run(kind, seed, side, duration)
-    drifts = account_drifts(energies[0], energies[1:])
-    assert not drifts, '%s: the account drifts at %d steps; first: step %d, %.3g J (largest term %.3g J, largest ' \
-        'change %.3g J)' % ((describe(case), len(drifts)) + drifts[0])
-    gains = contact_change_gains(energies[0], energies[1:])
-    assert not gains, '%s: contact changes added energy at %d steps; largest: step %d, %.3g J (allowed %.3g J)' % (
-        (describe(case), len(gains)) + max(gains, key=lambda g: g[1] - g[2]))
+    assert_account_balances(case, energies[0], energies[1:])
+    assert_no_contact_change_gain(case, energies[0], energies[1:])
 
 
 @pytest.mark.parametrize('kind, seed, side, duration', REST_RUNS)
