@@ -4,8 +4,9 @@ Seeded confined masses of tests/py/rockmass_scenes.py (a cube cut by three
 joint sets at 1 m, the blocks touching its sides or base held, E = 1e9 Pa,
 friction 35 deg above every joint's dip), started from rest (the default) and
 run for a given time at dt = 1e-3 s on one thread. Per case: blocks, free
-blocks, the start from rest (static steps, converged, its wall time), then per
-step the mean and largest open-close solves, step cuts, the mean wall time and
+blocks, the start from rest (static steps, converged, the blocks it could not
+hold, its wall time), then per step the mean and largest open-close solves and
+friction-limit passes, step cuts, the mean wall time and
 its phases (narrow phase, assembly, solve), the free blocks' largest speed at
 the end and the energy account's contact changes. Each case runs in its own
 process (one YADE scene per process).
@@ -24,7 +25,8 @@ import sys
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-DEFAULT_CASES = 'junctions,oblique-4,orthogonal-4,oblique-6,orthogonal-6'
+DEFAULT_CASES = ','.join(['junctions'] + ['%s-4-%d' % (kind, seed) for kind in ('oblique', 'orthogonal')
+                                           for seed in range(1, 7)] + ['oblique-6', 'orthogonal-6'])
 
 
 def run_case(name, duration):
@@ -43,7 +45,7 @@ def run_case(name, duration):
     O.step()
     first = yade_dda.stats()
     settle = time.time() - start
-    solves, cuts, wall, narrow, assembly, solve = [], 0, 0.0, 0.0, 0.0, 0.0
+    solves, passes, cuts, wall, narrow, assembly, solve = [], 0, 0, 0.0, 0.0, 0.0, 0.0
     changes0 = first['energy']['contactChanges']
     while O.time < duration:
         t = time.time()
@@ -51,6 +53,7 @@ def run_case(name, duration):
         wall += time.time() - t
         s = yade_dda.stats()
         solves.append(s['openCloseIterations'])
+        passes += s['limitPasses']
         cuts += s['stepCuts']
         narrow += s['time']['narrowPhase']
         assembly += s['time']['assembly']
@@ -58,7 +61,8 @@ def run_case(name, duration):
     n = len(solves)
     return dict(case=name, description=R.describe(case), blocks=len(ids), free=len(free),
                 settleSteps=first['settleSteps'], settleConverged=bool(first['settleConverged']),
-                settleSeconds=settle, steps=n, meanSolves=sum(solves) / n, mostSolves=max(solves), stepCuts=cuts,
+                unsettled=len(first['unsettledBlocks']),
+                settleSeconds=settle, steps=n, meanSolves=sum(solves) / n, mostSolves=max(solves), meanPasses=passes / n, stepCuts=cuts,
                 msPerStep=1e3 * wall / n, msNarrowPhase=1e3 * narrow / n, msAssembly=1e3 * assembly / n,
                 msSolve=1e3 * solve / n, largestSpeed=max(O.bodies[i].state.vel.norm() for i in free),
                 contactChanges=s['energy']['contactChanges'] - changes0, time=O.time)
@@ -83,10 +87,11 @@ def main():
             raise SystemExit('case %s wrote no result' % name)
         rows.append(json.loads(line[0][7:]))
         r = rows[-1]
-        print('%-14s %5d blocks %4d free  settle %2d steps %-5s %6.1f s | %4d steps  solves %5.2f (most %2d)  cuts %d  '
+        print('%-14s %5d blocks %4d free  settle %2d steps %-5s unsettled %d %6.1f s | %4d steps  solves %5.2f '
+              '(most %2d)  passes %.2f  cuts %d  '
               '%7.1f ms/step (narrow %.1f, assembly %.1f, solve %.1f)  speed %.2e m/s  contact changes %.2e J'
-              % (r['case'], r['blocks'], r['free'], r['settleSteps'], r['settleConverged'], r['settleSeconds'],
-                 r['steps'], r['meanSolves'], r['mostSolves'], r['stepCuts'], r['msPerStep'], r['msNarrowPhase'],
+              % (r['case'], r['blocks'], r['free'], r['settleSteps'], r['settleConverged'], r['unsettled'],
+                 r['settleSeconds'], r['steps'], r['meanSolves'], r['mostSolves'], r['meanPasses'], r['stepCuts'], r['msPerStep'], r['msNarrowPhase'],
                  r['msAssembly'], r['msSolve'], r['largestSpeed'], r['contactChanges']), flush=True)
     os.makedirs(os.path.join(HERE, 'out'), exist_ok=True)
     path = os.path.join(HERE, 'out', 'rock_mass_rest.json')

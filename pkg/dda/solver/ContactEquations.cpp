@@ -293,6 +293,14 @@ double updateFrictionLimit(Contact& contact, bool apply) {
 	return std::abs(target - before);
 }
 
+double limitForceChange(const Contact& contact) {
+	const double before = contact.slipLimit;
+	const double target = slipLimit(contact, contact.trial.normalForce);
+	if (!(before > 0) || contact.trial.bonded) return std::abs(target - before);
+	const double spring = contact.shearStiffness * contact.stretch.norm();
+	return std::abs(std::min(spring, target) - std::min(spring, before));
+}
+
 Vector3 tangentialForce(const Contact& contact, const Block& blockI, const Block& blockJ, const Vector12& Di,
                         const Vector12& Dj) {
 	const TangentialTerm tangential = tangentialTerm(contact);

@@ -117,6 +117,14 @@ bool evaluateContact(Contact& contact, const Block& blockI, const Block& blockJ,
 // before the move [N]. Without `apply` only returns it.
 double updateFrictionLimit(Contact& contact, bool apply);
 
+// How far the contact's tangential force at its trial state would move [N]
+// if its limit went to tan(phi) max(N, 0) (+ c A) for its normal force now.
+// The force is min(ks |s|, L) along the stretch, so a contact inside both
+// cones (ks |s| <= min(L, L')) keeps its force exactly, and any other moves
+// by |min(ks |s|, L') - min(ks |s|, L)| <= |L' - L|. A contact with no limit
+// yet, or bonded (the new limit may break its bond), counts |L' - L|.
+double limitForceChange(const Contact& contact);
+
 // Whether the contact is closed in its trial state.
 inline bool isClosed(const Contact& contact) { return contact.trial.state != ContactState::Open; }
 

@@ -17,11 +17,23 @@ namespace {
 // 1e-4 the forces left over pushed a cube sliding along x sideways by 1e-7
 // m in a set-up symmetric in y.
 constexpr double kNewtonTolerance = 1e-10;
-// A step's friction limits are consistent with its normal forces when a pass
-// changes none by more than this fraction of the largest; a step makes at
-// most kLimitPasses passes (see solve()). Any limit >= 0 resists slip, so an
-// unsettled limit is an error in the friction's size, not in the energy.
+// A step's friction limits are consistent with its normal forces when moving
+// every limit to its normal force's would move no contact's tangential
+// force by more than this fraction of its blocks' largest limit
+// (limitForceChange: a contact inside both its old and its new cone keeps
+// its force, so its limit does not count; measureLimits); a step makes at
+// most kLimitPasses passes (see solve()). Per block, that is at least as
+// tight as the group test it replaces (1e-3 of the group's largest limit)
+// for every block. (At 5e-3 the 4 m jointed masses made a second pass half
+// as often, but a fuzzed pile whose first step is accepted unconverged then
+// crushed a block, and a random hull pile at 1e11 Pa, whose contacts add
+// energy between steps, threw a block 0.4 % faster than a fall from its
+// top.) Any limit >= 0 resists slip, so an unsettled limit is an error in
+// the friction's size, not in the energy.
 constexpr double kLimitTolerance = 1e-3;
+// While friction is scaled up (setScaledFriction) the limits themselves must
+// settle to this fraction of the group's largest.
+constexpr double kScaledLimitTolerance = 1e-3;
 constexpr int kLimitPasses = 12;
 }  // namespace
 
@@ -218,12 +230,54 @@ void OpenCloseIteration::measureLimits(std::vector<Contact>& contacts) {
 	// friction does, settled most steps in fewer solves but cycled in
 	// others and, accepted unsettled, lost a sliding cube a fifth of
 	// its speed in its first step.)
-	for (std::size_t c = 0; c < contacts.size(); ++c) {
+	//
+	// Each contact's change is measured against the force scale of its
+	// blocks: per moving block, the largest limit (before or after the
+	// move) among its contacts; the smaller of the two blocks' when both
+	// move. Against the group's largest limit instead, a light block's
+	// friction would be settled only to a fraction of the heaviest
+	// block's limits: for a 10 cm cube touching a 100 m prism, 1e-3 of
+	// the prism's is more than 1e5 times the cube's weight.
+	auto converged = [&](std::size_t c) {
 		const int g = contactGroup_[c];
-		if (group_.done[g] || !group_.passConverged(g, kNewtonTolerance)) continue;
-		const double change = updateFrictionLimit(contacts[c], false);
-		group_.limitChange[g] = std::max(group_.limitChange[g], change);
-		group_.largestLimit[g] = std::max(group_.largestLimit[g], contacts[c].slipLimit + change);
+		return !group_.done[g] && group_.passConverged(g, kNewtonTolerance);
+	};
+	if (scaledFriction_) {
+		// Start from rest's locked stage: the limits are far above any
+		// force the springs carry, and what must settle is the normal
+		// forces they follow, so the limits themselves count, against the
+		// group's largest limit as in a dynamic step's test before the
+		// force test replaced it.
+		for (std::size_t c = 0; c < contacts.size(); ++c) {
+			if (!converged(c)) continue;
+			const double change = updateFrictionLimit(contacts[c], false);
+			const int g = contactGroup_[c];
+			group_.limitChange[g] = std::max(group_.limitChange[g], change);
+			group_.largestLimit[g] = std::max(group_.largestLimit[g], contacts[c].slipLimit + change);
+		}
+		return;
+	}
+	const int n = static_cast<int>(moving_.size());
+	blockLimit_.assign(n, 0.0);
+	for (std::size_t c = 0; c < contacts.size(); ++c) {
+		if (!converged(c)) continue;
+		const double limit = contacts[c].slipLimit + updateFrictionLimit(contacts[c], false);
+		for (const int block : {contacts[c].bodyI, contacts[c].bodyJ}) {
+			const int k = movingIndex_[block];
+			if (k >= 0) blockLimit_[k] = std::max(blockLimit_[k], limit);
+		}
+	}
+	for (std::size_t c = 0; c < contacts.size(); ++c) {
+		if (!converged(c)) continue;
+		const double change = limitForceChange(contacts[c]);
+		if (!(change > 0)) continue;
+		const int ki = movingIndex_[contacts[c].bodyI], kj = movingIndex_[contacts[c].bodyJ];
+		const double scaleI = ki >= 0 ? blockLimit_[ki] : blockLimit_[kj];
+		const double scaleJ = kj >= 0 ? blockLimit_[kj] : blockLimit_[ki];
+		// Both blocks' scales hold this contact's max(L, L') >= change > 0.
+		const double scale = std::min(scaleI, scaleJ);
+		const int g = contactGroup_[c];
+		group_.limitChange[g] = std::max(group_.limitChange[g], change / scale);
 	}
 }
 
@@ -239,7 +293,9 @@ bool OpenCloseIteration::closePasses(int iterations, const Attempt& attempt, int
 			continue;
 		}
 		const bool converged = group_.passConverged(g, kNewtonTolerance);
-		const bool settled = group_.limitChange[g] <= kLimitTolerance * group_.largestLimit[g];
+		const bool settled = scaledFriction_
+		                         ? group_.limitChange[g] <= kScaledLimitTolerance * group_.largestLimit[g]
+		                         : group_.limitChange[g] <= kLimitTolerance;
 		// A converged pass is accepted with its limits unsettled after
 		// kLimitPasses passes, or once three quarters of the step's
 		// solves are spent: it is energy-safe (every limit >= 0
@@ -390,7 +446,7 @@ std::size_t OpenCloseIteration::memoryBytes() const {
 	return coupled_.memoryBytes() + capacityBytes(moving_) + capacityBytes(movingIndex_) +
 	       capacityBytes(solutions_) + capacityBytes(ownSystems_) + capacityBytes(ownSystemOf_) +
 	       capacityBytes(solvedAlone_) + capacityBytes(links_) + capacityBytes(hasSprings_) +
-	       capacityBytes(blockUnknowns_) + capacityBytes(iterate_) + capacityBytes(deltas_) + capacityBytes(lines_) +
+	       capacityBytes(blockLimit_) + capacityBytes(blockUnknowns_) + capacityBytes(iterate_) + capacityBytes(deltas_) + capacityBytes(lines_) +
 	       capacityBytes(groupRoot_) + capacityBytes(lineGroup_) + capacityBytes(groupLines_) +
 	       capacityBytes(orderedLines_) + capacityBytes(keptTerms_) + capacityBytes(keptTermsOf_) +
 	       capacityBytes(keptTermsKey_) + capacityBytes(groupKink_) + capacityBytes(groupSlope_) +

@@ -52,6 +52,10 @@ public:
 		coupled_.setAnalysisReuse(reuse);
 		keepTerms_ = reuse;
 	}
+	// Whether the friction is scaled up (World::settle's locked stage and
+	// its ramp): the passes' limit test then compares the limits
+	// themselves, not the tangential forces they would move (measureLimits).
+	void setScaledFriction(bool scaled) { scaledFriction_ = scaled; }
 	// The solver's heap [bytes] (World::MemoryUse::solver, World's motions aside).
 	std::size_t memoryBytes() const;
 
@@ -126,6 +130,7 @@ private:
 	std::vector<int> keptTermsOf_;             // per contact: its entry of keptTerms_, -1 if none
 	std::vector<unsigned char> keptTermsKey_;  // per contact: the state its kept terms are for
 	bool keepTerms_ = true;
+	bool scaledFriction_ = false;
 	// Newmark's start acceleration a0 of each moving block (unless Shi's
 	// scheme, which does not read it): M^-1 times the block's own forces at
 	// D = 0 (restForce). Contacts are left out: they enter as the step's mean
@@ -157,6 +162,8 @@ private:
 	struct GroupIteration {
 		std::vector<char> done, hasContacts, swungBack, newPass;
 		std::vector<int> passes, passSolves, changes;
+		// limitChange: relative to its contacts' scales, or (scaled friction)
+		// in newtons against largestLimit.
 		std::vector<double> forceChange, largestNormalForce, limitChange, largestLimit;
 		void reset(int groups);
 		void startIteration();
@@ -169,6 +176,7 @@ private:
 	std::vector<int> movingIndex_;  // block -> index in moving_, -1 for fixed blocks
 	std::vector<std::pair<int, int>> links_;  // buildSystemStructure's work arrays
 	std::vector<char> hasSprings_;
+	std::vector<double> blockLimit_;  // measureLimits' work array: per moving block, its contacts' largest limit [N]
 	std::vector<int> blockUnknowns_;  // per moving block: 12, or 6 when rigid
 	long aloneUnknowns_ = 0;          // of the moving blocks left out of coupled_
 	// per-step work arrays, kept to avoid reallocation

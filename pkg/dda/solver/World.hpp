@@ -142,13 +142,18 @@ private:
 	// step long enough to weigh 1e-3 of a contact's stiffness) with friction
 	// locked, for the blocks at rest whose touching contacts join them to a
 	// fixed block or point (the rest frozen), until a step moves no vertex by
-	// more than kSettleTolerance of the first's, or several in a row move them
-	// by no more than kSettleQuiet of it; then velocities zero, the account
-	// restarted. Not converged within kSettleSteps (no equilibrium with these
-	// contacts): the scene is restored as placed.
+	// more than kSettleTolerance of the first's, or several in a row leave
+	// the blocks quiet (by no more than kSettleQuiet of it, or an out-of-balance
+	// force of at most kSettleQuietAcceleration of their weight); then
+	// velocities zero, the account restarted. Not converged within
+	// kSettleSteps (no equilibrium with these contacts): the scene is
+	// restored as placed.
 	void settle(const IntegratorSettings& settings);
 	// settle's static steps, and its second stage with the true friction.
 	bool settlingSteps(const IntegratorSettings& statics, double longest, double& reference);
+	// One static step (counted in settleSteps_), the settling blocks' velocities
+	// zeroed after it; false when it has no static solution.
+	bool staticStep(const IntegratorSettings& statics, double longest);
 	void admitFriction(const IntegratorSettings& statics, double longest, double reference);
 	// frozen_ for settling: per block, 1 unless it settles (see settle).
 	void markSettlingBlocks();

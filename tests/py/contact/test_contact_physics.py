@@ -535,6 +535,28 @@ def test_block_rests_on_floor(scene):
     assert S.norm(S.sub(f, (0.0, 0.0, mass * G))) < 1e-3 * mass * G
 
 
+def test_a_block_landing_flat_needs_no_friction_pass(scene):
+    """A rigid 1 m cube dropped from 1 mm lands flat on a floor and bounces on it: its
+    four corners' normal forces swing from 0 to several times its weight and back, but
+    no tangential force acts (the drop is straight down), so every corner stays inside
+    its friction cone, old or new, and moving its limit to its normal force moves no
+    force: a pass's limits are settled without another pass (limitPasses stays 0). A
+    test on the limits themselves made a pass at every step of the landing."""
+    S.add_block(S.box((-2, -2, -1), (3, 3, 0)), S.rock(30.0), fixed=True)
+    block = S.add_block(S.box((0, 0, 1e-3), (1, 1, 1 + 1e-3)), S.rock(30.0), rigid=True)
+    O.engines = [integrator()]
+    passes, forces = 0, []
+    while O.time < 0.1:
+        O.step()
+        s = yade_dda.stats()
+        passes += s['limitPasses']
+        forces.append(O.forces.f(block)[2])
+    weight = yade_dda.block(block).mass * G
+    assert max(forces) > 2 * weight, (max(forces), weight)   # the landing loads the corners
+    print('largest force / weight %.2f, limit passes %d' % (max(forces) / weight, passes))
+    assert passes == 0, passes
+
+
 @pytest.mark.parametrize('phiDeg', [15.0, 30.0])
 def test_block_launched_along_floor_slides_to_a_stop(scene, phiDeg):
     """A 1 m cube resting on a floor, launched at v0 = 2 m/s along x, slides

@@ -415,6 +415,10 @@ def test_a_confined_mass_settles_and_stays_at_rest(scene, kind, seed, side, dura
     assert first['settleConverged'] and first['settledBlocks'] == free, (
         '%s: start from rest: converged %s, %d of %d free blocks settled in %d static steps'
         % (describe(case), first['settleConverged'], first['settledBlocks'], free, first['settleSteps']))
+    # Settled with the true friction, not left in the locked state: no block the
+    # friction could not hold (every joint dips below the friction angle).
+    assert not first['unsettledBlocks'], '%s: start from rest left blocks %s unsettled' % (
+        describe(case), list(first['unsettledBlocks']))
     assert speed < AT_REST_SPEED, '%s: a free block at %.3g m/s after %g s' % (describe(case), speed, duration)
 
 
@@ -428,15 +432,16 @@ def test_a_settled_mass_keeps_its_energy_account(scene, kind, seed, side, durati
 @pytest.mark.parametrize('kind, seed, side, duration', REST_RUNS)
 def test_a_settled_mass_needs_few_solves_and_no_cut(scene, kind, seed, side, duration):
     """The target: at most 5 open-close solves a step on average and the time step at
-    its maximum. Not met yet: contacts on steep joints that carry next to no load keep
-    changing state (7 to 15 solves a step, a few cuts on orthogonal stacks); reported
-    as an expected failure with its numbers, a failure beyond 20 solves or 10 cuts."""
+    its maximum. Met by some seeded masses (1 solve); others take up to 10.5, the
+    contacts at the edge of their friction cones switching between stick and slip for
+    three or four solves of a pass, and one or two more passes: reported as an expected
+    failure with its numbers, a failure beyond 15 solves or any cut."""
     case, _, _, _, solves, cuts, _ = rest_run(kind, seed, side, duration)
     mean = sum(solves) / len(solves)
     message = '%s: %.2f open-close solves a step on average (most %d), %d step cuts in %d steps' % (
         describe(case), mean, max(solves), sum(cuts), len(solves))
-    assert mean <= 20 and sum(cuts) <= 10, message
-    if mean > 5 or sum(cuts):
+    assert mean <= 15 and sum(cuts) == 0, message
+    if mean > 5:
         pytest.xfail(message)
 
 
