@@ -277,3 +277,21 @@ def test_blocks_in_flight_keep_their_motion_while_others_settle(scene):
         runs[start] = tuple(b.centroid) + tuple(b.velocity)
         assert abs(b.velocity[0] - 2) < 1e-12 and abs(b.velocity[2] - (3 - G * O.time)) < 1e-9, b.velocity
     assert runs[True] == runs[False]
+
+
+def test_a_frictionless_scene_makes_no_friction_ramp(scene):
+    """The settling releases locked friction in five static steps (friction x 100, 10, 3,
+    1.5, 1.2) before the true friction; a scene whose contacts have no friction has
+    nothing to release and makes none of them: a cube settling on a floor takes exactly
+    five static steps more with 30 deg of friction than without (both settle on a flat
+    floor the same way)."""
+    steps = {}
+    for phi in (0.0, 30.0):
+        O.reset()
+        S.build_resting_block(frictionDeg=phi)
+        O.engines = [DDAIntegrator(dt=1e-3, gravity=(0, 0, -G), label='dda')]
+        O.run(1, True)
+        s = yade_dda.stats()
+        assert s['settleConverged'] and not s['unsettledBlocks'], s
+        steps[phi] = s['settleSteps']
+    assert steps[30.0] == steps[0.0] + 5, steps
