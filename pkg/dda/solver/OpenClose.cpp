@@ -446,7 +446,8 @@ std::size_t OpenCloseIteration::memoryBytes() const {
 	return coupled_.memoryBytes() + capacityBytes(moving_) + capacityBytes(movingIndex_) +
 	       capacityBytes(solutions_) + capacityBytes(ownSystems_) + capacityBytes(ownSystemOf_) +
 	       capacityBytes(solvedAlone_) + capacityBytes(links_) + capacityBytes(hasSprings_) +
-	       capacityBytes(blockLimit_) + capacityBytes(blockUnknowns_) + capacityBytes(iterate_) + capacityBytes(deltas_) + capacityBytes(lines_) +
+	       capacityBytes(blockLimit_) + capacityBytes(blockUnknowns_) + capacityBytes(iterate_) +
+	       capacityBytes(deltas_) + capacityBytes(lines_) +
 	       capacityBytes(groupRoot_) + capacityBytes(lineGroup_) + capacityBytes(groupLines_) +
 	       capacityBytes(orderedLines_) + capacityBytes(keptTerms_) + capacityBytes(keptTermsOf_) +
 	       capacityBytes(keptTermsKey_) + capacityBytes(groupKink_) + capacityBytes(groupSlope_) +

@@ -278,12 +278,13 @@ void World::admitFriction(const IntegratorSettings& statics, double longest, dou
 	const std::vector<Block> locked = blocks_;
 	const ContactStore lockedContacts = store_;
 	const double lockedSprings = energy_.contact;
-	// (A scene without friction has nothing to release: no ramp.)
+	// A scene without friction has nothing to release: no ramp.
 	bool ramped = true;
-	for (const double scale : kFrictionRamp) {
-		if (stats_.frictionContacts == 0) break;
-		frictionScale_ = scale;
-		if (!(ramped = staticStep(statics, longest))) break;
+	if (stats_.frictionContacts > 0) {
+		for (const double scale : kFrictionRamp) {
+			frictionScale_ = scale;
+			if (!(ramped = staticStep(statics, longest))) break;
+		}
 	}
 	frictionScale_ = 1;
 	openClose_.setScaledFriction(false);
