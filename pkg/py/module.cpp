@@ -285,6 +285,9 @@ py::dict lastStep(const SceneLink& s) {
 	d["refinedComponents"] = st.refinedComponents;
 	d["refineIterations"] = st.refineIterations;
 	d["refineFallbacks"] = st.refineFallbacks;
+	d["iterativeComponents"] = st.iterativeComponents;
+	d["iterativeIterations"] = st.iterativeIterations;
+	d["iterativeFallbacks"] = st.iterativeFallbacks;
 	d["limitPasses"] = st.limitPasses;
 	d["limitsUnsettled"] = st.limitsUnsettled;
 	d["settleSteps"] = st.settleSteps;

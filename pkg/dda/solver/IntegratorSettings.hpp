@@ -77,6 +77,9 @@ struct StepStatistics {
 	int refinedComponents = 0;       // components solved by refinement, not factorised (all attempts)
 	int refineIterations = 0;        // their conjugate-gradient iterations (all attempts)
 	int refineFallbacks = 0;         // refinements that did not converge and were factorised (all attempts)
+	int iterativeComponents = 0;     // components solved by the iterative path (all attempts)
+	int iterativeIterations = 0;     // its conjugate-gradient iterations (all attempts)
+	int iterativeFallbacks = 0;      // iterative solves that did not converge and were factorised (all attempts)
 	int limitPasses = 0;             // passes made after the first because friction limits changed (all attempts)
 	int limitsUnsettled = 0;         // attempts accepted with limits still changing after kLimitPasses passes
 	// start from rest (IntegratorSettings::startFromRest): the settling before the

@@ -130,6 +130,7 @@ void OpenCloseIteration::startAttempt(const Attempt& attempt, bool firstStep) {
 	if (!attempt.settings.gravity.isZero()) attempt.stats.bodyForceBlocks += n;
 	iterate_.assign(n, Vector12::Zero());
 	coupled_.beginAttempt(attempt.settings.refineSolves);
+	coupled_.setIterative(attempt.settings.iterativeSolveBlocks, attempt.settings.iterativeTolerance);
 	keptTerms_.clear();
 	keptTermsOf_.assign(contacts.size(), -1);
 	for (Contact& contact : contacts) {
@@ -172,6 +173,9 @@ void OpenCloseIteration::solveOnce(const Attempt& attempt, bool structureStale) 
 	stats.refinedComponents += coupled_.refinedComponents();
 	stats.refineIterations += coupled_.refineIterations();
 	stats.refineFallbacks += coupled_.refineFallbacks();
+	stats.iterativeComponents += coupled_.iterativeComponents();
+	stats.iterativeIterations += coupled_.iterativeIterations();
+	stats.iterativeFallbacks += coupled_.iterativeFallbacks();
 	if (lineSearch(attempt) < 1) ++stats.lineSearches;
 	stats.timeSolve += secondsSince(phase);
 }

@@ -509,7 +509,7 @@ def test_every_collider_gives_the_all_pairs_contacts(scene, kind, seed, side, st
             describe(case), name, len(moved))
 
 
-THREAD_RUNS = ([('oblique', 1, SIDE, 10), ('orthogonal', 1, SIDE, 10)]
+THREAD_RUNS = ([('oblique', 1, SIDE, 10), ('orthogonal', 1, SIDE, 10), ('oblique', 1, 7.0, 5)]
                + [pytest.param('oblique', seed, SIDE, 10, marks=pytest.mark.slow) for seed in (2, 3, 4)]
                + [pytest.param('orthogonal', 1, 12.0, 2, marks=pytest.mark.slow)])    # some 15 to 20 minutes
 
@@ -521,20 +521,25 @@ def test_one_and_two_threads_give_the_same_bits(scene, kind, seed, side, steps):
     """The same seeded mass on 1 and 2 threads: after every step the blocks'
     corners, centroids and velocities, and YADE's bodies' positions and
     velocities, are bitwise equal.
-    (The narrow phase runs threaded at any size; the loops over contacts from
-    2,048 contacts and over moving blocks from 1,024, which only the 12 m
-    orthogonal cube reaches: 1,452 free blocks, some 32,000 sub-contacts.)"""
+    (The narrow phase runs threaded at any size; the iterative solve's block
+    rows from 128 blocks in one component, which the 7 m cube reaches: 155
+    free blocks; the loops over contacts from 2,048 contacts and over moving
+    blocks from 1,024, which only the 12 m orthogonal cube reaches: 1,452
+    free blocks, some 32,000 sub-contacts.)"""
     case = case_of(kind, seed, side)
     print(describe(case))
     runs = []
     for threads in (1, 2):
         O.reset()
         ids, _, _ = R.build_scene(case, dt=DT, startFromRest=False, threads=threads)
-        seen = []
+        seen, iterated = [], 0
         for _ in range(steps):
             O.step()
             seen.append((blocks_bits(ids), bodies_bits()))
+            iterated += yade_dda.stats()['iterativeComponents']
         runs.append(seen)
+        if side >= 7:
+            assert iterated > 0, '%s: the iterative solve was not taken' % describe(case)
     for step, ((blocks1, bodies1), (blocks2, bodies2)) in enumerate(zip(*runs), 1):
         differ = [ids[k] for k, (x, y) in enumerate(zip(blocks1, blocks2)) if x != y]
         assert not differ, '%s: step %d, %d blocks differ on 1 and 2 threads (first body %d)' % (
