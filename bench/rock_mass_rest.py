@@ -13,6 +13,7 @@ process (one YADE scene per process).
 
 Writes bench/out/rock_mass_rest.json and prints a table.
 Run: /usr/bin/python3 bench/rock_mass_rest.py [--cases junctions,oblique-4,...] [--time 0.2]
+[--set NAME=VALUE ...] (DDAIntegrator settings for every case)
 A case is 'junctions' (the fixed 5 m cube whose held base tetrahedra expose
 only their bases) or KIND-SIDE[-SEED] with KIND oblique or orthogonal and SIDE
 the cube's edge [m] (seed 1 unless given).
@@ -29,7 +30,7 @@ DEFAULT_CASES = ','.join(['junctions'] + ['%s-4-%d' % (kind, seed) for kind in (
                                            for seed in range(1, 7)] + ['oblique-6', 'orthogonal-6'])
 
 
-def run_case(name, duration):
+def run_case(name, duration, settings=None):
     """One case in this process: a dict of its numbers."""
     sys.path.insert(0, os.path.join(HERE, '..', 'tests', 'py'))
     import yade_dda
@@ -40,7 +41,7 @@ def run_case(name, duration):
     else:
         parts = name.split('-')
         case = R.draw_case(int(parts[2]) if len(parts) > 2 else 1, kind=parts[0], side=float(parts[1]))
-    ids, fixed, free = R.build_scene(case, dt=1e-3, threads=1)
+    ids, fixed, free = R.build_scene(case, dt=1e-3, threads=1, **(settings or {}))
     start = time.time()
     O.step()
     first = yade_dda.stats()
@@ -72,15 +73,18 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument('--cases', default=DEFAULT_CASES)
     parser.add_argument('--time', type=float, default=0.2, help='simulated time after the start from rest [s]')
+    parser.add_argument('--set', action='append', default=[], metavar='NAME=VALUE',
+                        help='a DDAIntegrator setting for every case (a number), e.g. --set staticFrictionExcess=0')
     parser.add_argument('--one', help=argparse.SUPPRESS)
     args = parser.parse_args()
+    settings = {k: float(v) for k, v in (item.split('=', 1) for item in args.set)}
     if args.one:
-        print('RESULT ' + json.dumps(run_case(args.one, args.time)))
+        print('RESULT ' + json.dumps(run_case(args.one, args.time, settings)))
         return
     rows = []
     for name in args.cases.split(','):
-        out = subprocess.run([sys.executable, os.path.abspath(__file__), '--one', name, '--time', str(args.time)],
-                             capture_output=True, text=True)
+        out = subprocess.run([sys.executable, os.path.abspath(__file__), '--one', name, '--time', str(args.time)]
+                             + ['--set=' + item for item in args.set], capture_output=True, text=True)
         line = [l for l in out.stdout.splitlines() if l.startswith('RESULT ')]
         if not line:
             sys.stderr.write(out.stdout[-2000:] + out.stderr[-2000:])
@@ -96,7 +100,7 @@ def main():
     os.makedirs(os.path.join(HERE, 'out'), exist_ok=True)
     path = os.path.join(HERE, 'out', 'rock_mass_rest.json')
     with open(path, 'w') as f:
-        json.dump(dict(time=args.time, threads=1, rows=rows), f, indent=1)
+        json.dump(dict(time=args.time, threads=1, settings=settings, rows=rows), f, indent=1)
     print('wrote', path)
 
 

@@ -77,7 +77,11 @@ struct Contact {
 	LinearizedDistance normal;   // gap d0 and its gradients e_i, e_j
 	double normalStiffness = 0;  // [N/m]
 	double shearStiffness = 0;   // [N/m]
-	double frictionTangent = 0;  // tan(friction angle) [-]
+	double frictionTangent = 0;  // tan(friction angle) [-], times staticFriction
+	// Static friction (IntegratorSettings::staticFrictionExcess): 1 + excess
+	// while a contact that ended the last step locked has not slipped in a
+	// converged pass of this step, else 1.
+	double staticFriction = 1;
 	double area = 0;             // share of its pair's contact area [m^2]; 0 when the pair has no bond strength (only bonds use it)
 	double cohesionForce = 0;    // bond's shear strength beyond friction [N]
 	double tensileForce = 0;     // bond's tensile strength [N]

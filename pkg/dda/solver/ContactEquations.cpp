@@ -107,6 +107,12 @@ void prepareContact(Contact& contact, const Block& blockI, const Block& blockJ, 
 	contact.normalStiffness = settings.contactPenaltyFactor * std::min(stiffnessI, stiffnessJ);
 	contact.shearStiffness = settings.shearStiffnessRatio * contact.normalStiffness;
 	contact.frictionTangent = std::tan(std::min(blockI.material.frictionAngle, blockJ.material.frictionAngle));
+	// Static friction (IntegratorSettings::staticFrictionExcess): a contact
+	// that ended the last step locked holds up to (1 + excess) Coulomb's
+	// limit until it slips (dropStaticFriction); one that slid, or is new,
+	// has Coulomb's.
+	contact.staticFriction = contact.history.state == ContactState::Locked ? 1 + settings.staticFrictionExcess : 1.0;
+	contact.frictionTangent *= contact.staticFriction;
 	contact.cohesionForce = std::min(blockI.material.cohesion, blockJ.material.cohesion) * contact.area;
 	contact.tensileForce = std::min(blockI.material.tensileStrength, blockJ.material.tensileStrength) * contact.area;
 	contact.normal = linearizeNormalDistance(contact.geometry.stencil, blockI.centroid, blockJ.centroid);
@@ -291,6 +297,12 @@ double updateFrictionLimit(Contact& contact, bool apply) {
 	contact.slipLimit = before + weight * change;
 	contact.limitChange = weight * change;
 	return std::abs(target - before);
+}
+
+void dropStaticFriction(Contact& contact) {
+	if (contact.staticFriction == 1 || !contact.slipping) return;
+	contact.frictionTangent /= contact.staticFriction;
+	contact.staticFriction = 1;
 }
 
 double limitForceChange(const Contact& contact) {

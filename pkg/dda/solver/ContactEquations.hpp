@@ -117,6 +117,11 @@ bool evaluateContact(Contact& contact, const Block& blockI, const Block& blockJ,
 // before the move [N]. Without `apply` only returns it.
 double updateFrictionLimit(Contact& contact, bool apply);
 
+// A contact that slips with static friction's limit (Contact::staticFriction
+// > 1) goes over to Coulomb's: its friction tangent loses the factor. The
+// limit follows at the next pass (measureLimits, startPasses).
+void dropStaticFriction(Contact& contact);
+
 // How far the contact's tangential force at its trial state would move [N]
 // if its limit went to tan(phi) max(N, 0) (+ c A) for its normal force now.
 // The force is min(ks |s|, L) along the stretch, so a contact inside both

@@ -265,6 +265,10 @@ void OpenCloseIteration::measureLimits(std::vector<Contact>& contacts) {
 	blockLimit_.assign(n, 0.0);
 	for (std::size_t c = 0; c < contacts.size(); ++c) {
 		if (!converged(c)) continue;
+		// A contact that broke away from static friction slides at
+		// Coulomb's limit: another pass with it, when that moves its force
+		// by more than the tolerance (a limit change like any other).
+		dropStaticFriction(contacts[c]);
 		const double limit = contacts[c].slipLimit + updateFrictionLimit(contacts[c], false);
 		for (const int block : {contacts[c].bodyI, contacts[c].bodyJ}) {
 			const int k = movingIndex_[block];

@@ -179,7 +179,10 @@ void World::settle(const IntegratorSettings& settings) {
 	unsettled_.clear();
 	double first = -1;
 	settleConverged_ = settlingSteps(statics, longest, first);
-	if (settleConverged_) admitFriction(statics, longest, first);
+	if (settleConverged_) {
+		admitFriction(statics, longest, first);
+		lockSettledContacts();
+	}
 	settling_ = false;
 	openClose_.setScaledFriction(false);
 	frictionScale_ = 1;
@@ -293,6 +296,19 @@ void World::admitFriction(const IntegratorSettings& statics, double longest, dou
 	store_ = lockedContacts;
 	energy_.contact = lockedSprings;
 	collider_->setPairReuse(false);  // its cache saw the moved blocks
+}
+
+void World::lockSettledContacts() {
+	// The settled state is at rest: no contact slips. One that ended the
+	// settling at its friction limit is in static equilibrium there, and
+	// starts the dynamics locked, so that static friction
+	// (staticFrictionExcess) holds it as any contact at rest. Energy: the
+	// label changes no force, anchor or stored energy (a sliding contact
+	// ends its step with the stretch L / ks that carries its limit,
+	// finishContact), only which limit the next step gives it.
+	for (Contact& contact : store_.contacts())
+		if (contact.history.state == ContactState::Sliding && contact.frictionTangent > 0)
+			contact.history.state = ContactState::Locked;
 }
 
 void World::dropFrozenContacts(StepStatistics& stats) {

@@ -159,6 +159,8 @@ private:
 	void markSettlingBlocks();
 	// While settling: drops the contacts of two frozen (or fixed) blocks.
 	void dropFrozenContacts(StepStatistics& stats);
+	// After a converged start from rest: contacts at their friction limit start locked.
+	void lockSettledContacts();
 	std::vector<char> frozen_;   // per block while settling, else empty
 	bool settling_ = false;
 	double frictionScale_ = 1;   // friction tangents x this (settling: locked)

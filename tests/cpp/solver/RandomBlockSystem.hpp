@@ -143,12 +143,13 @@ struct RandomSystem {
 // alternate layers crossing, 1 cm apart and slightly turned (seed 9): each
 // beam lands across every beam of the layer below, so the settling stack is
 // one dense component (as the paper's hexahedra drop), where refinement pays.
-inline World crossedBeams(int layers, int perLayer) {
+// Friction angle `frictionDeg` [deg].
+inline World crossedBeams(int layers, int perLayer, double frictionDeg = 30) {
 	const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
 	World world;
 	world.setCollider(std::make_unique<DESSCollider>());
 	Material rock;
-	rock.frictionAngle = 30 * M_PI / 180;
+	rock.frictionAngle = frictionDeg * M_PI / 180;
 	world.addBlock(orientedBox(Vector3(0, 0, -0.5), Vector3(4, 4, 0.5), I), rock, true);
 	std::mt19937 rng(9);
 	std::uniform_real_distribution<double> tilt(-0.01, 0.01);

@@ -189,15 +189,18 @@ TEST(IterativeSolve, ReportsAnUnconvergedSolve) {
 	EXPECT_LE(sys.backwardError(x), 1e-14 + 1e-15);
 }
 
-// A settling stack of crossed beams stepped from the same saved states with
-// the iterative path (from 2 blocks, the default tolerance 1e-10) and
-// without: the same contact states, vertices within 2e-5 of the step's
-// largest motion. (Measured: at most 5.6e-6. The normwise backward error
-// weighs the beams' rotation rows, lever arms of 2 m, with their
-// translations: the solution's relative error is that times a few 1e4. Its
-// solves may take one more or one fewer open-close pass.)
+// A settling stack of frictionless crossed beams stepped from the same
+// saved states with the iterative path (from 2 blocks, the default
+// tolerance 1e-10) and without: as many closed contacts, vertices within
+// 1e-5 of the step's largest motion (measured: 4e-7; the normwise backward
+// error weighs the beams' rotation rows, lever arms of 2 m, with their
+// translations). Frictionless, because the open-close iteration
+// accepts a pass once its friction limits move forces by at most 1e-3 of
+// their blocks' scale: two solutions within the solver's tolerance can end
+// a pass apart, and then differ by up to 2e-3 of a step's motion (measured
+// with 30 deg of friction), the iteration's tolerance, not the solver's.
 TEST(IterativeSolve, PileStepMatchesTheFactorisedStep) {
-	World world = crossedBeams(4, 4);
+	World world = crossedBeams(4, 4, 0.0);
 	IntegratorSettings direct = gravitySettings(true);
 	direct.iterativeSolveBlocks = 0;
 	IntegratorSettings iterative = direct;
@@ -228,7 +231,7 @@ TEST(IterativeSolve, PileStepMatchesTheFactorisedStep) {
 				moved = std::max(moved, (a.centroid - before[k]).norm());
 			}
 			if (moved > 0) worst = std::max(worst, difference / moved);
-			EXPECT_LE(difference, 2e-5 * moved) << "step " << step;
+			EXPECT_LE(difference, 1e-5 * moved) << "step " << step;
 			++compared;
 		} else {
 			world.step(direct);

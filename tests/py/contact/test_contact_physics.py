@@ -422,12 +422,12 @@ def test_block_held_by_friction_on_incline(scene):
     holds the cube; in 2 s it moves less than 1e-4 m (elastic shear of the block and the
     shear springs: ~1e-6 m), and no contact carries more than its limit tan(phi) N.
 
-    Not every contact is locked: the springs share the downhill pull about equally (3188 N
-    per corner), but the uphill corners carry 2334 N of normal force, so their limit is
-    1634 N and they stand at it (state 'sliding', no slip: the block does not move), the
-    downhill ones (8710 N) take the rest locked. Before the start from rest ended with the
-    true friction (World::admitFriction) the uphill corners slipped in the first step, the
-    cube lurched and rang, and ended just under the limit (0.998 of it) as 'locked'."""
+    The springs share the downhill pull about equally (3188 N per corner), but the uphill
+    corners carry 2334 N of normal force, so their limit is 1634 N: the start from rest's
+    static steps with the true friction leave them at it (World::admitFriction), at rest.
+    The settled state is at rest, so they start locked (World::lockSettledContacts) and stay
+    so: every closed contact is locked after 2 s. (Left 'sliding', they stood at the limit
+    with no slip; before admitFriction they slipped in the first step and the cube rang.)"""
     geo, slab, block = S.build_incline(INCLINE, INCLINE_BLOCK, 35.0)
     O.engines = [integrator()]
     c0 = centroid(block)
@@ -436,8 +436,41 @@ def test_block_held_by_friction_on_incline(scene):
     assert S.norm(rotation_vector(block)) < 1e-4
     closed = [c for c in yade_dda.contacts() if c.state != 'open']
     mu = math.tan(math.radians(35.0))
-    assert closed and any(c.state == 'locked' for c in closed)
+    assert len(closed) == 4 and all(c.state == 'locked' for c in closed), [c.state for c in closed]
     assert all(S.norm(tuple(c.shearForce)) <= mu * c.normalForce * (1 + 1e-6) for c in closed)
+
+
+# (case, the slope's pull over Coulomb's limit tan(a) / tan(phi), staticFrictionExcess or None for the default)
+STATIC_FRICTION_CASES = [('held-within-the-excess', 1.005, None), ('slides-without-excess', 1.005, 0.0),
+                         ('slides-at-coulombs-limit', 1.03, None)]
+
+
+@pytest.mark.parametrize('case,pull,excess', STATIC_FRICTION_CASES, ids=[c[0] for c in STATIC_FRICTION_CASES])
+def test_static_friction_holds_up_to_its_excess_and_slides_at_coulombs_limit(scene, case, pull, excess):
+    """A rigid cube started at rest on a 30 deg incline whose friction angle
+    gives tan(a) = pull x tan(phi). Static friction (staticFrictionExcess,
+    1e-2 by default): a contact locked at the start of a step slips only
+    beyond (1 + excess) tan(phi) N, and once it slips it has tan(phi) N. So
+    at 1.005 the cube stays put (measured: 4e-8 m in 2 s); with the excess
+    at 0 it slides at Coulomb's g (sin a - tan(phi) cos a), 4.88 cm in 2 s;
+    at 1.03 it slides at that acceleration too, from its first step
+    (measured: 0.28573 m, as Coulomb's to 5 digits). Rigid: a deformable
+    cube's base spreads by Poisson's ratio, and its locked corners' radial
+    forces take part of their limits (a 1 m cube of this rock slid at 1.005)."""
+    phi = math.atan(math.tan(INCLINE) / pull)
+    geo = S.incline_geometry(INCLINE, INCLINE_BLOCK)
+    S.add_block(geo['slab'], S.rock(math.degrees(phi)), fixed=True)
+    block = S.add_block(geo['block'], S.rock(math.degrees(phi)), rigid=True)
+    O.engines = [integrator() if excess is None else integrator(staticFrictionExcess=excess)]
+    c0 = centroid(block)
+    run_to(2.0)
+    slid = S.dot(S.sub(centroid(block), c0), geo['frame'][0])
+    expected = S.incline_slide_distance(INCLINE, phi, O.time)
+    print('%s: slid %.4e m, Coulomb %.4e m' % (case, slid, expected))
+    if case == 'held-within-the-excess':
+        assert abs(slid) < 1e-6, '%s: slid %.3e m' % (case, slid)
+    else:
+        assert abs(slid - expected) < 1e-4 * expected, '%s: slid %.5e m, Coulomb %.5e m' % (case, slid, expected)
 
 
 @pytest.mark.parametrize('phiBlock,phiSlab', [(20.0, 45.0), (45.0, 20.0)], ids=['block-lower', 'slab-lower'])
