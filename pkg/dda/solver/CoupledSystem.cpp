@@ -231,6 +231,7 @@ std::size_t CoupledSystem::memoryBytes() const {
 	std::size_t kept = capacityBytes(analyses_) + capacityBytes(componentAnalysis_) + capacityBytes(componentHash_) +
 	                   analysisByHash_.size() * (sizeof(std::size_t) + sizeof(Analysis*) + 2 * sizeof(void*));
 	for (const AnalysisPtr& a : analyses_) kept += sizeof(Analysis) + capacityBytes(a->pattern) + a->bytes;
+	kept += iterative_.memoryBytes();
 	return capacityBytes(slot_) + capacityBytes(members_) + capacityBytes(unknowns_) + capacityBytes(componentStart_) +
 	       capacityBytes(diagonal_) + capacityBytes(force_) + capacityBytes(linkSlots_) + capacityBytes(linkStart_) +
 	       capacityBytes(offDiagonal_) + kept;
@@ -400,7 +401,7 @@ bool CoupledSystem::iterateComponent(int c, std::vector<Vector12>& solutions, in
 	matrix.links = links.data();
 	matrix.linkCount = static_cast<int>(links.size());
 	matrix.sizes = &unknowns_[first];
-	BlockConjugateGradient& solver = iterative_[c];
+	BlockConjugateGradient& solver = iterative_;
 	iterations = 0;
 	if (!solver.prepare(matrix, std::min(threadsFrom, kIterativeThreadsFrom))) return false;
 	// The first iterate: this attempt's last solution (the open-close
@@ -423,7 +424,6 @@ void CoupledSystem::solve(std::vector<Vector12>& solutions, int threadsFrom) {
 	long solved = 0;
 	int reusedAnalyses = 0, newAnalyses = 0, refined = 0, refineIterations = 0, fallbacks = 0;
 	int iterated = 0, iterativeIterations = 0, iterativeFallbacks = 0;
-	if (static_cast<int>(iterative_.size()) < count) iterative_.resize(count);
 	// The iterative path first, one component after another, each threaded
 	// over its rows (inside the components' parallel loop below it would
 	// run on one thread); one that does not converge is factorised below.

@@ -215,11 +215,12 @@ private:
 	std::unordered_multimap<std::size_t, Analysis*> factorByMembers_;
 	bool refine_ = false;
 	int refinedComponents_ = 0, refineIterations_ = 0, refineFallbacks_ = 0;
-	// The iterative path: settings, per component its solver, and whether
-	// the solutions hold this attempt's last solve (the first iterate).
+	// The iterative path: settings, its solver (the components it takes run
+	// one after another), and whether the solutions hold this attempt's last
+	// solve (the first iterate).
 	int iterativeFrom_ = 0;
 	double iterativeTolerance_ = 0;
-	std::vector<BlockConjugateGradient> iterative_;
+	BlockConjugateGradient iterative_;
 	bool warm_ = false;
 	int iterativeComponents_ = 0, iterativeIterations_ = 0, iterativeFallbacks_ = 0;
 	// Solves component c iteratively; true when it converged.
