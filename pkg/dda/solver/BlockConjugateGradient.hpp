@@ -10,7 +10,8 @@
 // of a contact's stiffness to its blocks' mass term 2m/dt^2, and above a
 // floor set by the mass term; neither grows with the number of blocks, so
 // the iterations to a given backward error do not either (measured in
-// bench/solver.py on rock masses of 150 to 2,000 free blocks).
+// bench/solver.py: 35 iterations a solve at 155 free blocks, 50 from 372
+// to 1,674).
 //
 // Preconditioner: block Jacobi, z_i = K_ii^-1 r_i with each diagonal
 // block's inverse formed once per matrix (one 12x12 product per block, rows
