@@ -5,6 +5,7 @@
 #pragma once
 
 #include "dda/collider/Collider.hpp"
+#include "dda/core/StateStream.hpp"
 #include "dda/solver/CoupledSystem.hpp"
 #include "dda/solver/World.hpp"
 #include "TestScenes.hpp"
@@ -16,6 +17,7 @@
 #include <memory>
 #include <random>
 #include <set>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -164,6 +166,32 @@ inline World crossedBeams(int layers, int perLayer, double frictionDeg = 30) {
 			               rock, false);
 		}
 	return world;
+}
+
+// One step of `world` with `settings` and of a copy of it (saved and read
+// back: the same state, bitwise) with `twinSettings`; `twin` holds the copy
+// after its step. Returns the largest distance between the two's vertices
+// and sets `moved` to the largest centroid move of `world` in the step [m].
+inline double stepWithTwin(World& world, const IntegratorSettings& settings, World& twin,
+                           const IntegratorSettings& twinSettings, double& moved) {
+	StateWriter out;
+	world.writeState(out);
+	const std::string saved = out.bytes();
+	StateReader in(saved);
+	twin.readState(in);
+	std::vector<Vector3> before;
+	for (int k = 0; k < world.blockCount(); ++k) before.push_back(world.block(k).centroid);
+	world.step(settings);
+	twin.step(twinSettings);
+	double difference = 0;
+	moved = 0;
+	for (int k = 0; k < world.blockCount(); ++k) {
+		const Block &a = world.block(k), &b = twin.block(k);
+		for (std::size_t v = 0; v < a.vertices.size(); ++v)
+			difference = std::max(difference, (a.vertices[v] - b.vertices[v]).norm());
+		moved = std::max(moved, (a.centroid - before[k]).norm());
+	}
+	return difference;
 }
 
 inline double largestError(const std::vector<Vector12>& x, const std::vector<Vector12>& expected) {

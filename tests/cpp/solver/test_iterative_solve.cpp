@@ -5,7 +5,6 @@
 // Cholesky's solution (random SPD block systems, seeds in the messages),
 // bitwise equality across thread counts, and a settling stack stepped with
 // and without the iterative path from the same saved states.
-#include "dda/core/StateStream.hpp"
 #include "dda/solver/BlockConjugateGradient.hpp"
 #include "dda/solver/CoupledSystem.hpp"
 #include "dda/solver/World.hpp"
@@ -209,27 +208,13 @@ TEST(IterativeSolve, PileStepMatchesTheFactorisedStep) {
 	double worst = 0;
 	for (int step = 0; step < 150; ++step) {
 		if (step % 10 == 9) {
-			StateWriter out;
-			world.writeState(out);
 			World copy;
-			const std::string saved = out.bytes();
-			StateReader in(saved);
-			copy.readState(in);
-			std::vector<Vector3> before;
-			for (int k = 0; k < world.blockCount(); ++k) before.push_back(world.block(k).centroid);
-			world.step(direct);
-			copy.step(iterative);
+			double moved = 0;
+			const double difference = stepWithTwin(world, direct, copy, iterative, moved);
 			const StepStatistics& s = copy.lastStep();
 			iterativeSteps += s.iterativeComponents > 0;
 			ASSERT_EQ(s.closedContacts, world.lastStep().closedContacts) << "step " << step;
 			ASSERT_EQ(s.slidingContacts, world.lastStep().slidingContacts) << "step " << step;
-			double moved = 0, difference = 0;
-			for (int k = 0; k < world.blockCount(); ++k) {
-				const Block &a = world.block(k), &b = copy.block(k);
-				for (std::size_t v = 0; v < a.vertices.size(); ++v)
-					difference = std::max(difference, (a.vertices[v] - b.vertices[v]).norm());
-				moved = std::max(moved, (a.centroid - before[k]).norm());
-			}
 			if (moved > 0) worst = std::max(worst, difference / moved);
 			EXPECT_LE(difference, 1e-5 * moved) << "step " << step;
 			++compared;
