@@ -53,13 +53,13 @@ bench: install
 	$(PYTHON) bench/energy.py
 	$(PYTHON) bench/bounce.py
 
-# Issue 21's speed table (bench/out/scale.json, scale_steps.png): detection against YADE's collider,
+# The speed and scale table (bench/out/scale.json, scale_steps.png): detection against YADE's collider,
 # the full step on 1 and 2 threads and the sync's share at 1,000 to 50,000 blocks, the paper's drop
 # in steps per second. About half an hour (YADE's 50,000-block steps take seconds); needs a quiet machine.
 bench-scale: install
 	$(PYTHON) bench/scale.py
 
-# The issue-17 200-cube pile at 1e5..1e11 Pa (bench/out/energy_pile200.json): about half an hour
+# The slow energy test's 200-cube pile at 1e5..1e11 Pa (bench/out/energy_pile200.json): about half an hour
 # on one core, so not in `bench`.
 bench-pile200: install
 	$(PYTHON) bench/energy.py --pile200 --threads 1

@@ -1,4 +1,4 @@
-"""Benchmark (issue 5, part 1): what accuracy costs in time.
+"""Benchmark: what accuracy costs in time.
 
 Sweeps DDA's accuracy knobs on scenes with closed forms and records, for every
 run, the error against the closed form (SI units) and the wall time per
@@ -740,7 +740,7 @@ def main():
     for s in only or []:
         if s not in SCENES:
             parser.error('unknown scene %r (scenes: %s)' % (s, ', '.join(SCENES)))
-    result = dict(benchmark='accuracy against time (issue 5, part 1)', mode=mode, tEnd=tEnd, machine=machine(),
+    result = dict(benchmark='accuracy against time', mode=mode, tEnd=tEnd, machine=machine(),
                   settings=dict(plan={k: dict(values=PLAN[k][mode], scenes=PLAN[k]['scenes'], base=PLAN[k]['base'])
                                       for k in knobs},
                                 rock=ROCK, bounce=BOUNCE, wedge=WEDGE, slopeDeg=SLOPE_DEG, g=G,

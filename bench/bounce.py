@@ -1,4 +1,4 @@
-"""Benchmark: how much of an elastic bounce's energy each time scheme keeps (issue 17).
+"""Benchmark: how much of an elastic bounce's energy each time scheme keeps.
 
 A frictionless 1 m cube (2600 kg/m^3) dropped flat from 0.5 m onto a fixed floor,
 rigid or deformable, E = 1e8 or 1e10 Pa, under Shi's scheme (newmarkGamma 1, the

@@ -1,10 +1,10 @@
-"""Benchmark (issue 4): contact detection by each DDA strategy and by YADE's colliders, from
+"""Benchmark: contact detection by each DDA strategy and by YADE's colliders, from
 the paper's scenes to 50,000 randomly oriented slender blocks.
 
 Scenes: the three scenes of Wu et al. (2014), Section 5 (examples/paper/paper_scenes.py,
 with the paper's dt 1e-3 s and 0.01 m allowed step displacement, so d0 = 2.5 x 0.01 =
 25 mm, Shi's default), and random slender scenes of n = 1,000, 10,000 and 50,000 blocks
-(d0 = 10 mm, as in the issue's YADE figure; see ``slenderScene`` for how they are made).
+(d0 = 10 mm; see ``slenderScene`` for how they are made).
 
 Every (scene, strategy) runs in its own subprocess, one thread (OMP_NUM_THREADS=1,
 DDAIntegrator(threads=1), ompThreads=1 on every YADE engine), so its peak RSS
@@ -22,7 +22,7 @@ default pair cache, as a user would. Scenes of up to 1,000 blocks run every stra
 alternating rounds (--rounds, default 3) and report the median round; the machine's
 load changes between rounds fall on all strategies alike.
 
-Writes bench/out/colliders.json (everything, the issue's targets evaluated, machine,
+Writes bench/out/colliders.json (everything, MSC's targets evaluated, machine,
 versions, exactly what each program was told), PNG plots beside it, and prints a table.
 Run: make bench, or /usr/bin/python3 bench/colliders.py [--quick] [--sizes 1000,10000]
 (YADE_DDA_BUILD=<build>/py to use a build tree instead of the installed package).
@@ -463,7 +463,7 @@ def _ratio(a, b):
 
 
 def evaluateTargets(summaries, slenderScenes, strategies):
-    """The issue's targets, per scene (applied to the random slender scenes; the paper's scenes
+    """MSC's targets, per scene (applied to the random slender scenes; the paper's scenes
     are evaluated too, for information)."""
     by = {(s['scene'], s['strategy']): s for s in summaries}
     targets = []
@@ -517,7 +517,7 @@ def evaluateTargets(summaries, slenderScenes, strategies):
                 _ratio(msc['mean']['detectionMs'], isc['mean']['detectionMs']),
                 'YADE: collider + InteractionLoop execTime per step, one thread each', applies)
             add(scene, 'MSC peak RSS / YADE InsertionSortCollider peak RSS', 0.5, _ratio(msc['peakMB'], isc['peakMB']),
-                '"well under" read as at most half; whole-process peak RSS (as the issue\'s 740 MB), each run in its '
+                '"well under" read as at most half; whole-process peak RSS, each run in its '
                 'own process', applies)
             if 'colliderMB' in msc['mean']:
                 add(scene, 'MSC detection heap (collider + contacts + narrow phase) / YADE ISC memory added by '
@@ -729,7 +729,7 @@ def main():
     strategies = [s for s in args.strategies.split(',') if s]
     scenes = [s for s in args.paper.split(',') if s] + ['slender_%d' % n for n in sizes]
     started = time.time()
-    result = dict(benchmark='colliders (issue 4)', machine=machine(), scenes=scenes, strategies=strategies,
+    result = dict(benchmark='colliders', machine=machine(), scenes=scenes, strategies=strategies,
                   records=[], summaries=[],
                   skipped={}, failed={}, sceneInfo={}, settings=dict(
                       seed=args.seed, quick=args.quick, verletDist=args.verlet_dist, paperSteps=paperSteps,

@@ -1,4 +1,4 @@
-"""Benchmark (issue 21): the paper's 70-block hexahedra drop (examples/paper), steps per second in chunks.
+"""Benchmark: the paper's 70-block hexahedra drop (examples/paper), steps per second in chunks.
 
 The drop's cost depends on the state of its pile (the logs land, pile up in the V-shaped trough, rebound,
 then slide off its open ends and fall), so one rate says little: this runs the scene from the start in
@@ -6,7 +6,7 @@ chunks of ``--chunk`` steps of ``O.run`` (as a script runs it) and records each 
 then runs it again, the same trajectory, with a PyRunner summing every step's stats (its rates are not
 the scene's: reading stats syncs YADE's bodies every step) for each chunk's simulated time, the step's
 phases (ms per step), the open-close solves, refinements and step cuts, the contact pairs and the
-largest coupled component. Issue 21's target is 300 steps/s once piled up.
+largest coupled component. The target is 300 steps/s once piled up.
 
 Writes bench/out/drop.json (``--out``) and prints one line per chunk. Run:
 YADE_DDA_BUILD=<build>/py /usr/bin/python3 bench/drop.py [--chunks 12] [--chunk 300] [--threads 1]

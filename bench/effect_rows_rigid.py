@@ -1,4 +1,4 @@
-"""Benchmark row for the effect "rigid blocks" (issue 6): the same scene with every
+"""Benchmark row for the effect "rigid blocks": the same scene with every
 moving block rigid (6 unknowns, ddaBlock(..., rigid=True)) and deformable
 (12 unknowns), time per step and the largest difference in final positions.
 

@@ -1,12 +1,12 @@
-"""Benchmark: energy of a dropped pile of cubes against Young's modulus (issue 17).
+"""Benchmark: energy of a dropped pile of cubes against Young's modulus.
 
 30 slightly turned 1 m cubes (density 2600 kg/m^3, 30 deg friction) in layers
 of 3 x 3, 0.1 m apart, dropped onto a fixed floor with every integrator setting
 at its default, for 0.6 s. For each E it records what the hard-case tests
 assert and what it costs:
 - gain: the largest rise of kinetic (translation) plus potential energy above
-  its start, relative to the start (must stay below 1e-3; the contact law
-  before issue 17 gained 5-36% on 200 cubes at 1e11 Pa); gainFull: the same
+  its start, relative to the start (must stay below 1e-3; an earlier
+  contact law gained 5-36% on 200 cubes at 1e11 Pa); gainFull: the same
   with the energy account's kinetic energy (rotation and strain rates too);
 - speed: the fastest centroid over the free-fall bound sqrt(2 g z_top) (<= 1);
 - drift: the energy account's sum minus loads minus contactChanges, its change
@@ -27,7 +27,7 @@ Writes bench/out/energy.json and prints a table. SI units.
 Run: make bench (or /usr/bin/python3 bench/energy.py [--youngs 1e5 1e11] [--time 0.6];
 YADE_DDA_BUILD=<build>/py to use a build tree instead of the installed package).
 
---pile200: the issue's scene instead, the pile of
+--pile200: the slow test's scene instead, the pile of
 tests/py/solver/test_energy_and_creep.py::test_pile_of_200_cubes_never_gains_energy
 (200 cubes in 8 layers of 5 x 5, 0.2 m apart, the same seed and builder), for
 1.5 s, gain and speed sampled at every step (allLandedAt: when the last cube
@@ -219,7 +219,7 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--youngs', type=float, nargs='+', default=[1e5, 1e7, 1e9, 1e11])
     parser.add_argument('--time', type=float, default=None, help='simulated seconds (0.6; 1.5 with --pile200)')
-    parser.add_argument('--pile200', action='store_true', help="the issue's 200-cube pile (slow test's scene)")
+    parser.add_argument('--pile200', action='store_true', help="the slow test's 200-cube pile")
     parser.add_argument('--count', type=int, default=None, help='cubes of the slow test\'s pile builder')
     parser.add_argument('--side', type=int, default=5, help='cubes per layer side with --count')
     parser.add_argument('--threads', type=int, default=0, help='DDAIntegrator.threads (0: all)')

@@ -1,4 +1,4 @@
-"""Benchmark: why the frictional slides' error grows as dt shrinks (issue 5).
+"""Benchmark: why the frictional slides' error grows as dt shrinks.
 
 A 1 m cube (density 2600 kg/m^3) starts at rest on a fixed slab, gravity
 tilted 30 deg, friction 20 deg: it must slide with a = g (sin a - tan phi

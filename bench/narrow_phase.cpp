@@ -1,4 +1,4 @@
-// The narrow phase alone (issue 21): the candidate pairs of MSC on a slender deposit, each block's
+// The narrow phase alone: the candidate pairs of MSC on a slender deposit, each block's
 // planes built once (BlockPlanes), then every pair through detectPairContacts, repeated; prints the
 // best of the repetitions per candidate pair [us] (caches warm, no contact store, no contact set-up),
 // after one World::step's own narrow-phase time. A measuring aid for changes to pkg/dda/contact, not

@@ -1,4 +1,4 @@
-"""Benchmark: cutRockMass on a 40 m cube (issue 19; doc/rock-mass.md).
+"""Benchmark: cutRockMass on a 40 m cube (doc/rock-mass.md).
 
 Three oblique joint sets (dip/dip direction 35/020, 65/140, 80/250, through (0.3, 0.7, 0.1)) at 2 m
 (about 9,000 blocks) and at 1.09 m (about 50,000), and the 2 m case with a stochastic first set

@@ -1,4 +1,4 @@
-"""Benchmark (issue 21): speed and scale of the DDA step on random slender deposits, with the issue's targets.
+"""Benchmark: speed and scale of the DDA step on random slender deposits, with their targets.
 
 One table per size n (1,000, 10,000, 50,000 blocks; bench/colliders.py's seeded generator
 ``slenderScene``, d0 = 1 cm, so anyone can reproduce it):
@@ -131,7 +131,7 @@ def table(rows, drop):
 
 
 def detectionRow(n, det):
-    """Issue 21's detection columns for n blocks from _detection's strategies."""
+    """The detection columns for n blocks from _detection's strategies."""
     msc, dess, yade = det.get('MSC', {}), det.get('DESS', {}), det.get('InsertionSortCollider', {})
     return dict(
         blocks=n, mscDetectionMs=msc.get('detectionMs'), dessDetectionMs=dess.get('detectionMs'),
@@ -218,7 +218,7 @@ def main():
                                      if r['mscOverYade']},
                         candidatesOverPairs={str(r['blocks']): r['candidatesOverPairs'] <= TARGETS['candidatesOverPairs']
                                              for r in rows})
-        result = dict(benchmark='scale (issue 21), detection only', machine=colliders.machine(), seed=args.seed,
+        result = dict(benchmark='scale, detection only', machine=colliders.machine(), seed=args.seed,
                       sizes=sizes, targets=TARGETS, verdicts=verdicts, rows=rows, seconds=time.time() - started,
                       detectionFrom=os.path.basename(collidersOut),
                       how='bench/colliders.py children, one thread each, means over the steps after the first')
@@ -248,7 +248,7 @@ def main():
         mscOverYade={str(r['blocks']): r['mscOverYade'] <= TARGETS['mscOverYade'] for r in rows if r['mscOverYade']},
         candidatesOverPairs={str(r['blocks']): r['candidatesOverPairs'] <= TARGETS['candidatesOverPairs'] for r in rows},
         dropStepsPerSecond={k: v >= TARGETS['dropStepsPerSecond'] for k, v in drop['stepsPerSecond'].items()})
-    result = dict(benchmark='scale (issue 21)', machine=colliders.machine(), seed=args.seed, sizes=sizes,
+    result = dict(benchmark='scale', machine=colliders.machine(), seed=args.seed, sizes=sizes,
                   targets=TARGETS, verdicts=verdicts, rows=rows, drop=drop, seconds=time.time() - started,
                   detectionFrom=os.path.basename(collidersOut),
                   how='detection: bench/colliders.py children, one thread each, means over the steps after the first; '

@@ -1,4 +1,4 @@
-# concave_blocks.py -- concave blocks (issue 19): an L made of three cubes, the same L given by its
+# concave_blocks.py -- concave blocks: an L made of three cubes, the same L given by its
 # triangulated surface, and a slope with a bench cut by two joint sets into concave blocks.
 #   1. The L falls onto a floor and a cube drops into its inner corner: printed, its volume, centroid
 #      and inertia against the closed form, and where the cube rests (on the foot, off the wall).

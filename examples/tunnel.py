@@ -1,4 +1,4 @@
-# tunnel.py -- a tunnel in jointed rock whose crown loosens (issue 19), against key-block theory.
+# tunnel.py -- a tunnel in jointed rock whose crown loosens, against key-block theory.
 # A 24 m x 20 m x 24 m box of rock (E = 1e10 Pa, density 2600, joints frictional at 30 degrees, no
 # cohesion) is cut by three oblique joint sets through one point above the crown (cutRockMass), and a
 # box-shaped tunnel (6 m x 6 m, its roof at z = 13 m) is taken out along y.

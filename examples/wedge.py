@@ -1,4 +1,4 @@
-# wedge.py -- a wedge on a cut slope (issue 19) against the limit-equilibrium (Hoek-Bray) factor of
+# wedge.py -- a wedge on a cut slope against the limit-equilibrium (Hoek-Bray) factor of
 # safety. A 20 m x 20 m x 10 m prism whose front face dips 65 degrees towards +x is cut by two joints
 # (dip 50, dip directions 60 and 120) through a point of the face 2 m above the toe; the tetrahedral
 # wedge above both joints is free, the rest fixed. The joints' friction angle is chosen for the factor

@@ -16,7 +16,7 @@ Tolerances. Sliding: the acceleration is constant and DDA's scheme is exact
 for it, but the cube settles at rest with its friction locked (start from
 rest) and must then go over to sliding: in the first steps its contact forces
 and elastic modes start up and it keeps a small velocity offset (doc/benchmarks.md,
-"What accuracy costs"). Measured on the core of issue 17 (b7154a7): the frictional
+"What accuracy costs"). Measured on core b7154a7: the frictional
 rows of full.table and the same scene at dt 1e-4 s are within 6e-5 of s and
 3e-5 of v; 1% is a margin. Frictionless
 the contact force is normal to the slope and the motion along it is exact up

@@ -1,4 +1,4 @@
-"""Rock masses cut by joint sets: ``cutRockMass`` (issue 19; doc/rock-mass.md).
+"""Rock masses cut by joint sets: ``cutRockMass`` (doc/rock-mass.md).
 
 The core (pkg/dda/geometry/RockMassCutter.hpp) cuts exactly: every corner is
 the exact intersection of three planes, rounded toward zero, so neighbouring

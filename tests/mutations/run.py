@@ -1,4 +1,4 @@
-"""Mutation checks of the hard-case suite (issue 5): each case class fails
+"""Mutation checks of the hard-case suite: each case class fails
 when the core mechanism that guards it is removed.
 
 Every `*.patch` in this directory is one mutation: a unified diff against the

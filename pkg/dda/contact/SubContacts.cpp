@@ -603,7 +603,7 @@ bool atCrossing(const SubContact& c, const SubContact& crossing, double merge) {
 //
 // The fold rule: a corner within d0 of f's plane that is not f's (its projection
 // more than d0 from f, or below f's plane deeper than the pair's
-// penetration; session 9) is measured against its own entrance face:
+// penetration) is measured against its own entrance face:
 // ownEntranceContact keeps it when its own
 // entrance face G of `owner` (the exposed face it lies farthest above)
 // has it within d0, no deeper than the penetration (`lowest`), its
@@ -615,7 +615,7 @@ bool atCrossing(const SubContact& c, const SubContact& crossing, double merge) {
 // entrance, as where a nearly planar side is split at a shallow fold
 // and a block rocks about the fold onto the other face, had no contact
 // until that face was the entrance, and it entered within a step
-// unopposed. Random hulls (27 in a box, session 9): at E = 1e11 Pa a
+// unopposed. Random hulls (27 in a box): at E = 1e11 Pa a
 // corner 0.65 m from the entrance's contacts, over a face 2.4 degrees
 // from the entrance face, 35 to 2.6 mm from it for 12 steps, found
 // first 0.34 mm deep (3.3e4 J in one step); at 1e9 Pa a corner 0.46 mm
@@ -793,7 +793,7 @@ void otherFeaturesOfEdgeEntrance(const Prepared& a, const Prepared& b, const Ent
 // may lie elsewhere on the block: with the entrance crossing alone, b pivots
 // about it and drives its other crossing into F's block within a step
 // (random hulls at E = 1e11 Pa: a crossing found first at 0.88 mm deep, 4.0e5
-// J in its spring; measured in session 9, doc/benchmarks.md). Each such
+// J in its spring; measured on random hulls, doc/benchmarks.md). Each such
 // crossing is the edge-edge contact the face search would give were F the
 // entrance (edge of the block crossing F as i, F's edge as j, normal within
 // 60 degrees of F's, no deeper than the pair's penetration, not beside a
@@ -1015,7 +1015,7 @@ DeepestEdgePoint deepestEdgePoint(const Prepared& block, int e, const Prepared& 
 // had no spring before). That first-step gain remains: the pair has no open
 // contact within d0 before it overlaps, so the overlap's first step, up to
 // the step's relative motion, is met compressed.
-// Tried and not kept (branch helper-npar; the oracle's 48 scenes, 8 seeds:
+// Tried and not kept (the oracle's 48 scenes, 8 seeds:
 // sum of the steps' gains 2.96e6 J, largest single step 2.26e5 J before):
 // the same contact made while the pair is within d0, open at a positive gap.
 // (1) At any point of the edge: the point of an edge nearest the other

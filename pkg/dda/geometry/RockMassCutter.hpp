@@ -1,5 +1,5 @@
 // cutRockMass: the blocks of a rock domain cut by joint sets, single joints
-// and excavations (issue 19, "Rock masses cut by joint sets"; doc/rock-mass.md).
+// and excavations (doc/rock-mass.md).
 //
 // The domain is one convex corner list or several convex parts (a concave
 // domain given as its convex pieces); each part is cut on its own and its

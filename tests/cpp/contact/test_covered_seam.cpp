@@ -19,7 +19,7 @@
 // of a few nm at E = 1e11 Pa), rose into W with no force from W, and was
 // found 175 um deep a few steps later (random hulls in a box, seed 2,
 // dt 2.5e-4 s: 8.2e3 J in one step, a fifth of the run's largest energy
-// change; session 10). One placement has q inside W (dz < 0) behind G by
+// change). One placement has q inside W (dz < 0) behind G by
 // more than the pair's penetration (W's bottom, internal, is nearer): there
 // too the contact is -e.
 // And where q is outside the fixed mass, no contact: a floor thinner than dz

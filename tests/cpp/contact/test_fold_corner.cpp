@@ -17,7 +17,7 @@
 // unopposed within a step (random hulls: a corner 0.65 m from the entrance's
 // contacts, within d0 of the face beside it for 12 steps, found first
 // 0.34 mm deep at E = 1e11 Pa, 3.3e4 J in one step; another 0.46 mm deep
-// at 1e9 Pa, 690 J; measured in session 9, bench/energy.py --hulls).
+// at 1e9 Pa, 690 J; measured with bench/energy.py --hulls).
 // Oracle: P's distance from F2's plane, n2 . (P - ridge point), which is g
 // by construction (computed here, independently of the narrow phase). The
 // scene is also turned by random rotations (seed printed) and given in both

@@ -1,4 +1,4 @@
-"""Every block ddaBlock accepts steps (issue 17, item 5).
+"""Every block ddaBlock accepts steps.
 
 Random turned triangular prisms and hexahedra (parallelepipeds), 1:1 to
 1000:1, at distances from the origin up to 1e6 m, far apart (no contacts):
@@ -191,15 +191,15 @@ def test_random_prisms_and_hexahedra_far_apart_all_step(scene):
 
 @pytest.mark.slow
 def test_ten_thousand_random_blocks_all_step(scene):
-    """The issue's count: 10,000 random turned prisms and hexahedra, 1:1 to 1000:1, up to 1e6 m from the origin."""
+    """10,000 random turned prisms and hexahedra, 1:1 to 1000:1, up to 1e6 m from the origin."""
     count = 10000
     accepted, refused, worst = _dropFarApart(count, SEED + 1)
     _report(count, SEED + 1, accepted, refused, worst)
     assert accepted >= 0.95 * count
 
 
-def test_cube_far_from_origin_of_the_issue_steps(scene):
-    """The issue's case: a 1 m cube at x = y = 1e5 m (YADE merged its faces: volume 4/3, centroid 6 cm off)."""
+def test_cube_1e5_m_from_origin_steps(scene):
+    """A 1 m cube at x = y = 1e5 m (YADE merged its faces: volume 4/3, centroid 6 cm off)."""
     mat = material(O, young=1e9)
     body = O.bodies.append(ddaBlock(box((1e5, 1e5, 0), (1e5 + 1, 1e5 + 1, 1)), material=mat))
     assert abs(O.bodies[body].state.mass / (2600 * 1.0) - 1) < 1e-12

@@ -1,4 +1,4 @@
-"""ddaBlock(points, hull=True): any point cloud makes a block, the convex hull of the points (issue 18).
+"""ddaBlock(points, hull=True): any point cloud makes a block, the convex hull of the points.
 
 Oracle: the hull's volume computed here, independently of CGAL and of the
 core, by brute force on the points themselves: every triple of points whose

@@ -76,7 +76,7 @@ def test_slender_deposit_every_strategy_finds_the_all_pairs_contacts(scene):
     """A loose deposit of 150 slender blocks as bench/colliders.py builds them
     (each within d0 of the block it landed on, none overlapping), 40 steps
     under gravity: MSC's frame-tested shells and DESS give AllPairs' contacts
-    at every step, MSC proposes at most twice the pairs within d0 (issue 4),
+    at every step, MSC proposes at most twice the pairs within d0 (its target),
     and no sub-contact starts deeper than an edge crossing may (d0): crossed
     logs once got edge crossings 1 m "deep" from a face axis of theirs."""
     sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', '..', 'bench'))

@@ -1,4 +1,4 @@
-"""cutRockMass(..., concave=True): 3DEC's joined blocks (issue 19: part lists for concaveBlock).
+"""cutRockMass(..., concave=True): 3DEC's joined blocks (part lists for concaveBlock).
 
 Oracles: joined blocks lie in one joint cell (the same side of every joint plane, exact from the
 corners) and no two groups of one cell touch; volumes add up to the domain's; the fraction of a

@@ -1,4 +1,4 @@
-"""cutRockMass (issue 19, "Rock masses cut by joint sets"; doc/rock-mass.md).
+"""cutRockMass (doc/rock-mass.md, "Rock masses cut by joint sets").
 
 Oracles, not replays: each block's corners are checked against the exact
 intersection of the three planes the block says they are (Python's

@@ -1,4 +1,4 @@
-"""No function in the C++ core is longer than a reader can hold (issue 20).
+"""No function in the C++ core is longer than a reader can hold.
 
 LIMIT below is the one definition of the bound: no function body in pkg/
 (C++ sources and headers, the binding included) spans more than LIMIT lines,

@@ -1,4 +1,4 @@
-"""The C++ core's layers only look down (issue 20; doc/DESIGN.md, "Source layout and layers").
+"""The C++ core's layers only look down (doc/DESIGN.md, "Source layout and layers").
 
 LAYERS below is the one definition of the layer order. Each entry is
 (rank, name, folders under pkg/): a file may include headers of its own layer

@@ -1,7 +1,7 @@
 """Every mutation patch (tests/mutations/*.patch, doc/testing.md "Mutation checks") still applies to
 the sources: a patch whose target moved would make `make mutations` fail to apply it, and the
-mechanism it guards would go unchecked (found in session 6: two patches had gone stale when the
-solver's contacts took their bodies)."""
+mechanism it guards would go unchecked (two patches went stale that way when the solver's
+contacts took their bodies)."""
 import glob
 import os
 import subprocess

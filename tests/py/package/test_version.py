@@ -1,4 +1,4 @@
-"""yade_dda.__version__ is CMakeLists.txt's project version, and results record it (issue 18)."""
+"""yade_dda.__version__ is CMakeLists.txt's project version, and results record it."""
 import os
 import re
 

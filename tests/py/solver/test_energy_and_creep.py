@@ -1,4 +1,4 @@
-"""The energy account, energy-safe contacts and holding slopes (issue 17), against
+"""The energy account, energy-safe contacts and holding slopes, against
 oracles rather than replayed scenes: the account's own conservation law, free-fall
 speed bounds, closed forms, and random piles with a printed seed (SI units).
 
@@ -148,7 +148,7 @@ def test_random_hulls_dropped_into_a_box_keep_the_energy_account(scene, young):
     plus potential energy never rises above its start by 0.1%; damping and friction
     never negative; the account balances to 1e-3 of the largest change. Contact changes
     between steps should add no energy beyond 1e-3 of the largest change. They do not
-    (bench/energy.py --hulls 8, session 9: up to 1.1% of it at 1e9 Pa, 10 to 77% at 1e11
+    (bench/energy.py --hulls 8: up to 1.1% of it at 1e9 Pa, 10 to 77% at 1e11
     Pa, seeds 1 to 8, 1 s), mostly from contacts kept from step to step whose next start,
     on the moved geometry, is deeper than the step's linear gap said (an edge-edge gap at
     a small crossing angle is far from linear in the blocks' turns: -10.7 um at the next
@@ -167,7 +167,7 @@ def test_random_hulls_dropped_into_a_box_keep_the_energy_account(scene, young):
 @pytest.mark.slow
 @pytest.mark.parametrize('young', [1e5, 1e7, 1e9, 1e11])
 def test_pile_of_200_cubes_never_gains_energy(scene, young):
-    """The issue's scene: 200 slightly turned 1 m cubes in 8 layers of 5 x 5 dropped
+    """200 slightly turned 1 m cubes in 8 layers of 5 x 5 dropped
     onto a fixed floor, every setting at its default: kinetic plus potential energy
     never above its start by more than 0.1%, both with the centroids' kinetic energy
     and with the account's (rotation and strain rates too), and no cube faster than
@@ -311,8 +311,8 @@ def test_wedge_that_must_hold_does_not_creep(scene, shape, fs):
     """A tetrahedral wedge on two planes (plunge of their line, the planes' angles xi
     and beta, azimuth, tan(phi_B)/tan(phi_A), as test_contact_physics.WEDGES) with
     each plane's friction set for the Hoek-Bray factor of safety fs: no steady
-    motion, less than 20 um between 0.5 s and 1 s (the issue's wedge crept at 2.1
-    mm/s at FS 1.078 on the earlier contact law)."""
+    motion, less than 20 um between 0.5 s and 1 s (the wedge given by dips below crept at
+    2.1 mm/s at FS 1.078 on the earlier contact law)."""
     plunge, xi, beta, azimuth, ratio = shape
     geo = S.wedge_geometry(math.radians(plunge), math.radians(xi), math.radians(beta), azimuth=azimuth,
                            origin=(3.0, -2.0, 10.0))
@@ -321,15 +321,15 @@ def test_wedge_that_must_hold_does_not_creep(scene, shape, fs):
     assert S.norm(S.sub(c2, c1)) < 2e-5, (c1, c2)
 
 
-# The issue's Hoek-Bray wedge, given the way rock engineers give it: joint planes A and
+# A Hoek-Bray wedge given the way rock engineers give it: joint planes A and
 # B by dip / dip direction [deg] (clockwise from north = +y; x = east), equal friction.
-ISSUE_WEDGE = (40.0, 130.0, 60.0, 220.0)
-ISSUE_ORIGIN = (3.0, -2.0, 10.0)
+WEDGE_DIPS = (40.0, 130.0, 60.0, 220.0)
+WEDGE_ORIGIN = (3.0, -2.0, 10.0)
 
 
-def issue_wedge(order=ISSUE_WEDGE):
+def wedge_of_dips(order=WEDGE_DIPS):
     """scenes.wedge_from_dips for planes (dip A, dip direction A, dip B, dip direction B) [deg]."""
-    return S.wedge_from_dips(*[math.radians(a) for a in order], origin=ISSUE_ORIGIN)
+    return S.wedge_from_dips(*[math.radians(a) for a in order], origin=WEDGE_ORIGIN)
 
 
 def outward_normal(face, inside):
@@ -339,10 +339,10 @@ def outward_normal(face, inside):
     return S.scale(-1.0, n) if S.dot(S.sub(inside, face[0]), n) > 0 else n
 
 
-def test_closed_form_issue_wedge_from_dips_is_the_requested_wedge():
+def test_closed_form_wedge_from_dips_is_the_requested_wedge():
     """scenes.wedge_from_dips builds the wedge the dips describe (no DDA).
 
-    For the issue's planes (40/130 as A, 60/220 as B, and the other way round) and
+    For the planes of WEDGE_DIPS (40/130 as A, 60/220 as B, and the other way round) and
     300 random two-plane wedges: the top face of each fixed slab, its normal taken
     from the slab's own corners and pointing out of the slab (up), has the requested
     dip and dip direction to 1e-12 rad; so do the returned nA, nB. The wedge sits ON
@@ -353,12 +353,12 @@ def test_closed_form_issue_wedge_from_dips_is_the_requested_wedge():
     (1e-12). Which plane carries more follows from Lami's theorem in the section
     perpendicular to the line: the weight's component there, w, balances R_A n_A and
     R_B n_B, so R_A / R_B = sin(angle(w, n_B)) / sin(angle(w, n_A)), computed from
-    angles only (wedge_reactions solves the 2x2 system instead). For the issue's
+    angles only (wedge_reactions solves the 2x2 system instead). For that
     wedge the 40 deg plane's normal is 16 deg from w, the 60 deg plane's 51 deg, so
     the gentler plane A carries 2.8 times B's reaction.
     """
     rng = random.Random(SEED)
-    cases, refused = [ISSUE_WEDGE, ISSUE_WEDGE[2:] + ISSUE_WEDGE[:2]], 0
+    cases, refused = [WEDGE_DIPS, WEDGE_DIPS[2:] + WEDGE_DIPS[:2]], 0
     while len(cases) < 302:
         case = (rng.uniform(10, 80), rng.uniform(0, 360), rng.uniform(10, 80), rng.uniform(0, 360))
         if abs(math.sin(math.radians(case[1] - case[3]))) < 0.2:
@@ -373,7 +373,7 @@ def test_closed_form_issue_wedge_from_dips_is_the_requested_wedge():
             cases.append(case)
     assert refused > 0
     for case in cases:
-        geo = issue_wedge(case)
+        geo = wedge_of_dips(case)
         want = [math.radians(a) for a in case]
         _, c = S.tetrahedron_volume_centroid(geo['wedge'])
         for key, n, (dip, direction) in (('A', geo['nA'], want[:2]), ('B', geo['nB'], want[2:])):
@@ -403,8 +403,8 @@ def test_closed_form_issue_wedge_from_dips_is_the_requested_wedge():
         angle = {k: math.acos(S.dot(w, geo[k])) for k in ('nA', 'nB')}
         assert RA > 0 and RB > 0
         assert abs(RA / RB - math.sin(angle['nB']) / math.sin(angle['nA'])) < 1e-10 * RA / RB
-        if case == ISSUE_WEDGE:
-            print('issue wedge: trend %.3f plunge %.3f xi %.3f beta %.3f deg, R_A %.4f W, R_B %.4f W, '
+        if case == WEDGE_DIPS:
+            print('wedge of dips: trend %.3f plunge %.3f xi %.3f beta %.3f deg, R_A %.4f W, R_B %.4f W, '
                   'normals %.2f and %.2f deg from the weight'
                   % tuple([math.degrees(geo[k]) for k in ('trend', 'plunge', 'xi', 'beta')] + [RA, RB]
                           + [math.degrees(angle['nA']), math.degrees(angle['nB'])]))
@@ -412,7 +412,7 @@ def test_closed_form_issue_wedge_from_dips_is_the_requested_wedge():
 
 
 @pytest.mark.parametrize('order', ['A=40/130', 'A=60/220'])
-def test_closed_form_issue_wedge_factor_of_safety_is_hoek_bray(order):
+def test_closed_form_wedge_of_dips_factor_of_safety_is_hoek_bray(order):
     """The vector FS of the dip-built wedge (scenes.wedge_factor_of_safety: reactions from
     equilibrium perpendicular to the line, friction R tan(phi) against W sin(psi_i))
     equals the textbook Hoek-Bray form FS = sin(beta) / sin(xi/2) tan(phi) / tan(psi_i)
@@ -420,7 +420,7 @@ def test_closed_form_issue_wedge_factor_of_safety_is_hoek_bray(order):
     to 50 deg; and the friction scenes.friction_for_wedge_fs finds for FS 0.9, 1.02 and
     1.078 (equal on both planes, or tan(phi_B) = 1.5 tan(phi_A)) gives back that FS to
     1e-12 (no DDA)."""
-    geo = issue_wedge(ISSUE_WEDGE if order == 'A=40/130' else ISSUE_WEDGE[2:] + ISSUE_WEDGE[:2])
+    geo = wedge_of_dips(WEDGE_DIPS if order == 'A=40/130' else WEDGE_DIPS[2:] + WEDGE_DIPS[:2])
     nA, nB = geo['nA'], geo['nB']
     for phiDeg in range(10, 51, 5):
         phi = math.radians(phiDeg)
@@ -434,16 +434,16 @@ def test_closed_form_issue_wedge_factor_of_safety_is_hoek_bray(order):
             assert abs(S.wedge_factor_of_safety(nA, nB, phiA, phiB) - fs) < 1e-12 * fs
             if ratio == 1.0:
                 assert abs(S.hoek_bray_factor_of_safety(geo['xi'], geo['beta'], geo['plunge'], phiA) - fs) < 1e-12
-    print('issue wedge: phi = %.4f deg for FS 1.078' % math.degrees(S.friction_for_wedge_fs(nA, nB, 1.078)[0]))
+    print('wedge of dips: phi = %.4f deg for FS 1.078' % math.degrees(S.friction_for_wedge_fs(nA, nB, 1.078)[0]))
 
 
 @pytest.mark.parametrize('fs', [1.02, 1.078])
-def test_issue_wedge_given_by_dips_holds(scene, fs):
-    """The issue's own wedge (planes 40/130 and 60/220, built from the dips by
+def test_wedge_given_by_dips_holds(scene, fs):
+    """The wedge of WEDGE_DIPS (planes 40/130 and 60/220, built from the dips by
     scenes.wedge_from_dips) with equal friction on both planes for the Hoek-Bray
     factor of safety fs: no steady motion, less than 20 um of centroid motion between
     0.5 s and 1 s (on the earlier contact law it slid 2.1 mm/s at FS 1.078)."""
-    geo = issue_wedge()
+    geo = wedge_of_dips()
     wedge, phiA, phiB = wedge_scene(geo, fs)
     c1, c2 = motion_between(wedge, 0.5, 1.0)
     moved = S.norm(S.sub(c2, c1))
@@ -454,7 +454,7 @@ def test_issue_wedge_given_by_dips_holds(scene, fs):
 
 
 @pytest.mark.parametrize('dt', [2e-3, 1e-3])
-def test_issue_wedge_below_fs_one_slides_as_coulomb_says(scene, dt):
+def test_wedge_given_by_dips_below_fs_one_slides_as_coulomb_says(scene, dt):
     """The same wedge at FS 0.9 slides (so the hold test above can fail), as a rigid
     wedge sliding down the line of intersection l with Coulomb friction on both planes:
     perpendicular to l nothing accelerates, which gives the reactions R_A, R_B
@@ -473,7 +473,7 @@ def test_issue_wedge_below_fs_one_slides_as_coulomb_says(scene, dt):
     0.06% off. The velocity gain is held to 0.05%, the motion across l to 1e-3 of the
     slide.
     """
-    geo = issue_wedge()
+    geo = wedge_of_dips()
     wedge, phiA, phiB = wedge_scene(geo, 0.9, dt=dt)
     RA, RB = S.wedge_reactions(geo['nA'], geo['nB'])
     acc = G * (math.sin(geo['plunge']) - (RA * math.tan(phiA) + RB * math.tan(phiB)))

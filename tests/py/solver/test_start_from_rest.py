@@ -1,4 +1,4 @@
-"""Start from rest (DDAIntegrator(startFromRest=True), the default; issue 17), against
+"""Start from rest (DDAIntegrator(startFromRest=True), the default), against
 closed forms and static equilibrium (SI units).
 
 Before the first step, blocks at rest that touch a fixed block (or carry fixed

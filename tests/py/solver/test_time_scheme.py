@@ -1,5 +1,5 @@
 """The Newmark family of DDAIntegrator(newmarkBeta, newmarkGamma) against closed forms
-and the energy account (issue 17; SI units).
+and the energy account (SI units).
 
 The accepted members have beta = gamma/2 (positions by the trapezoidal rule):
 gamma = 1 is Shi's scheme (the default), gamma = 1/2 average acceleration. Oracles:
@@ -122,7 +122,7 @@ def drop(rigid, dt, duration, newmark, young=1e9, chunk=10):
 
 def test_rigid_bounce_under_average_acceleration_keeps_its_energy(scene):
     """Average acceleration: a rigid cube rebounds to its drop height at each of 5
-    bounces (at least 99.9%, the issue asks 85%: the apex is sampled every 10 steps),
+    bounces (at least 99.9%, where 85% is required: the apex is sampled every 10 steps),
     and the mechanical energy never rises above its start (1e-9)."""
     apexes, high, low, drift = drop(True, 1e-3, 3.3, AVERAGE)
     print('apexes', apexes, 'high', high, 'low', low, 'drift', drift)
@@ -135,7 +135,7 @@ def test_deformable_bounce_under_average_acceleration_keeps_its_energy(scene):
     """Average acceleration, a deformable cube (E = 1 GPa): over 5 bounces the
     mechanical energy (with the strain energy and the strain rates' kinetic energy,
     which the impacts excite and this scheme does not damp) keeps at least 95% of
-    the drop energy (the issue asks 85%) and never rises above its start by more
+    the drop energy (85% is required) and never rises above its start by more
     than 0.5% of it. Measured: -2.3% and +0.3%, all of it what the account does not
     book (the same drift): each step rebuilds the block's mass matrix and stress
     from its deformed shape (volume, second moments, rotated tensors), terms of

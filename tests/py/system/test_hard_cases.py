@@ -1,4 +1,4 @@
-"""Hard cases (issue 5): placements and motions where contact DDA is known to
+"""Hard cases: placements and motions where contact DDA is known to
 break, each checked for what could go wrong.
 
 Every case runs under the common guards of `hardguards.Guard`, after every

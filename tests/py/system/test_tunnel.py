@@ -1,4 +1,4 @@
-"""A tunnel in jointed rock whose crown loosens (issue 19) against key-block theory (Goodman & Shi).
+"""A tunnel in jointed rock whose crown loosens against key-block theory (Goodman & Shi).
 
 The scene is examples/tunnel.py's: a 24 m x 20 m x 24 m box of rock cut by three oblique joint sets
 (dip/dip direction 50/055, 58/125, 62/265, spacings 7, 7.5 and 6.5 m, each with a plane through

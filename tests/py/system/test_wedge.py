@@ -1,5 +1,5 @@
-"""A wedge on a cut slope against limit equilibrium (issue 19: "slope cut by joint sets in which a
-wedge slides, compared with the Hoek-Bray factor of safety").
+"""A wedge on a cut slope against limit equilibrium: a slope cut by joint sets in which a wedge
+slides, compared with the Hoek-Bray factor of safety.
 
 The slope: a prism 20 m (x) x 20 m (y) x 10 m (z), its front face dipping 65 degrees towards +x, its
 top horizontal. Two single joints through a point P on the slope face, 2 m above the toe (dip 50,

@@ -1,4 +1,4 @@
-"""Bad input, everywhere a user can type (issue 6, part 3; doc/user-guide.md, "Bad input").
+"""Bad input, everywhere a user can type (doc/user-guide.md, "Bad input").
 
 One test per case. Each asserts the exception and its message (which names
 the problem and the body or parameter) and that the scene is unchanged: the

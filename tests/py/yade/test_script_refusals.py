@@ -1,4 +1,4 @@
-"""What a YADE script can get wrong around the DDA engines, refused by name (issue 18).
+"""What a YADE script can get wrong around the DDA engines, refused by name.
 
 Each refusal is checked twice: the exception names the problem, and nothing
 changed (the engine's parameters and command, the scene's bodies, iteration

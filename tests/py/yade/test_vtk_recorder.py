@@ -1,4 +1,4 @@
-"""DDAVTKRecorder (issue 18, "YADE sees the DDA"): the files it writes, read
+"""DDAVTKRecorder (what YADE sees of the DDA in ParaView): the files it writes, read
 back with VTK's own readers, against the core's state and closed forms.
 
 - the blocks' .vtu: corners bitwise equal to block(i).vertices, one polyhedron

@@ -1,4 +1,4 @@
-"""What YADE sees of a DDA scene: O.interactions, O.forces, O.energy (issue 18; yade_dda/views.py).
+"""What YADE sees of a DDA scene: O.interactions, O.forces, O.energy (yade_dda/views.py).
 
 Oracles: the contact pairs of yade_dda.contacts(), the stack's weight, the
 sub-contacts' forces, the energy account of stats(), YADE's own meaning of
