@@ -33,6 +33,24 @@ using namespace narrow;
 // sub-contact's gap comes from its stencil without the full linearisation.
 // Every double result is computed by the same expressions as before.
 
+namespace {
+// Whether every axis that may be the pair's entrance lies more than d0
+// deeper than the pair's best axis of all. The covered-face rules (internal
+// faces, faces opposing one and the edges of one are no entrance) are for a
+// block that meets an exposed face of the fixed mass, as one sliding over a
+// flush seam does. Here it meets none: it touches the covered block only
+// where a corner or edge of it reaches the surface at a junction of held
+// blocks, and an entrance that deep measured its sub-contacts against a face
+// a block's width away, found or not as the blocks strained by 1e-8 m (each
+// time it came back, a compressed spring's energy was added). The pair's own
+// contact, as two convex blocks, follows the blocks' motion continuously and
+// is no deeper than their penetration (the depth bound, step 3).
+bool coveredOnly(const Prepared& a, const Prepared& b, const AxisSearch& axes, double d0) {
+	if (!a.internalFaces && !b.internalFaces) return false;
+	return axes.best() < axes.deepestBound - d0;
+}
+}  // namespace
+
 bool detectPairContacts(const BlockGeometry& blockA, const BlockGeometry& blockB, const DetectionSettings& settings,
                         PairContacts& out, const EntranceFeature& previous, const LinkedSubUnits* linked,
                         NarrowPhaseWork* work) {
@@ -70,6 +88,19 @@ bool detectPairContacts(const BlockGeometry& blockA, const BlockGeometry& blockB
 	if (linked && !(axes.deepestBound >= -0.5 * d0)) {
 		++work->fullSearches;
 		return detectPairContacts(blockA, blockB, settings, out, previous, nullptr, work);
+	}
+
+	// A pair that touches only where covered faces meet the surface is two
+	// plain convex blocks (coveredOnly); the full search decides that.
+	if (coveredOnly(a, b, axes, d0)) {
+		if (linked) {
+			++work->fullSearches;
+			return detectPairContacts(blockA, blockB, settings, out, previous, nullptr, work);
+		}
+		BlockGeometry plainA = blockA, plainB = blockB;
+		plainA.internalFaces = plainB.internalFaces = nullptr;
+		plainA.covers = plainB.covers = nullptr;
+		return detectPairContacts(plainA, plainB, settings, out, previous, nullptr, work);
 	}
 
 	// 2. The entrance feature (Entrance.hpp).

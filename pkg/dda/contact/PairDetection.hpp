@@ -27,6 +27,14 @@
 //        - among faces within lengthTolerance of the best: the larger area
 //          (equal to a relative 1e-9), then A before B, then the lower face
 //          index (deterministic).
+//      Internal faces (a flush fixed neighbour, or another part of the same
+//      concave block, covers them), faces opposing one and edges of one are
+//      no entrance. But a pair whose best eligible axis lies more than d0
+//      below its best axis of all touches no exposed face: it meets only
+//      where a corner or edge of the covered block reaches the surface at a
+//      junction of held blocks. It is detected as two plain convex blocks
+//      (no face internal). Against an eligible face that deep its
+//      sub-contacts came and went as the blocks strained by 1e-8 m.
 //   3. Sub-contacts. "Within d0" below means within d0 + lengthTolerance (a
 //      face is planar only to within its tolerance, so a corner touching it
 //      may lie that far off its triangle's plane). A face entrance F of block
@@ -43,7 +51,7 @@
 //          and so is a corner of I within d0 of F's plane that is not F's
 //          (its projection more than d0 from F, or deeper below the plane
 //          than the pair's penetration): a corner over a face of R beside
-//          F (session 9);
+//          F;
 //        - vertex-face G <- Q for each corner Q of F within d0 of I, G the
 //          face of I of largest signed distance of Q (Q's own entrance face),
 //          Q's projection within d0 of G, and Q not within
