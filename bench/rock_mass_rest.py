@@ -15,8 +15,10 @@ Writes bench/out/rock_mass_rest.json and prints a table.
 Run: /usr/bin/python3 bench/rock_mass_rest.py [--cases junctions,oblique-4,...] [--time 0.2]
 [--set NAME=VALUE ...] (DDAIntegrator settings for every case)
 A case is 'junctions' (the fixed 5 m cube whose held base tetrahedra expose
-only their bases) or KIND-SIDE[-SEED] with KIND oblique or orthogonal and SIDE
-the cube's edge [m] (seed 1 unless given).
+only their bases) or KIND-SIDE[-SEED[-pPERSISTENCE][-sSLOPE]] with KIND oblique
+or orthogonal, SIDE the cube's edge [m] (seed 1 unless given), PERSISTENCE the
+last steep set's persistence (concave blocks) and SLOPE the dip [deg] of a cut
+face (tests/py/rockmass_scenes.py, draw_case), e.g. oblique-6-1-p0.7-s60.
 """
 import argparse
 import json
@@ -40,7 +42,10 @@ def run_case(name, duration, settings=None):
         case = R.JUNCTIONS_CASE
     else:
         parts = name.split('-')
-        case = R.draw_case(int(parts[2]) if len(parts) > 2 else 1, kind=parts[0], side=float(parts[1]))
+        options = dict(persistence=None, slope=None)
+        for part in parts[3:]:
+            options[{'p': 'persistence', 's': 'slope'}[part[0]]] = float(part[1:])
+        case = R.draw_case(int(parts[2]) if len(parts) > 2 else 1, kind=parts[0], side=float(parts[1]), **options)
     ids, fixed, free = R.build_scene(case, dt=1e-3, threads=1, **(settings or {}))
     start = time.time()
     O.step()
@@ -98,7 +103,7 @@ def main():
                  r['settleSeconds'], r['steps'], r['meanSolves'], r['mostSolves'], r['meanPasses'], r['stepCuts'], r['msPerStep'], r['msNarrowPhase'],
                  r['msAssembly'], r['msSolve'], r['largestSpeed'], r['contactChanges']), flush=True)
     os.makedirs(os.path.join(HERE, 'out'), exist_ok=True)
-    path = os.path.join(HERE, 'out', 'rock_mass_rest.json')
+    path = os.path.join(HERE, 'out', os.environ.get('ROCK_MASS_REST_OUT', 'rock_mass_rest.json'))
     with open(path, 'w') as f:
         json.dump(dict(time=args.time, threads=1, settings=settings, rows=rows), f, indent=1)
     print('wrote', path)

@@ -50,6 +50,15 @@ void ContactStore::FlatIndex::reset(std::size_t entries) {
 }
 
 void ContactStore::beginStep() {
+	previousEdgePoints_.clear();
+	for (const Contact& contact : current_)
+		if (contact.key.kind == ContactKind::EdgeEdge && contact.geometry.stencil.kind == ContactKind::VertexFace)
+			previousEdgePoints_.push_back({pairKey(std::min(contact.key.blockI, contact.key.blockJ),
+			                                       std::max(contact.key.blockI, contact.key.blockJ)),
+			                               contact.key.blockI,
+			                               contact.key.feature1, contact.key.feature2, contact.point});
+	std::stable_sort(previousEdgePoints_.begin(), previousEdgePoints_.end(),
+	                 [](const EdgePoint& x, const EdgePoint& y) { return x.pair < y.pair; });
 	previous_.clear();
 	previous_.reserve(current_.size());
 	for (const Contact& contact : current_) previous_.push_back({contact.key, contact.history});
@@ -165,6 +174,19 @@ const EntranceFeature& ContactStore::previousEntrance(int a, int b) const {
 	return it == previousEntrances_.end() || it->first != key ? none : it->second;
 }
 
+KeptEdgePoint ContactStore::previousEdgePoint(int a, int b) const {
+	const std::uint64_t key = pairKey(std::min(a, b), std::max(a, b));
+	const auto it = std::lower_bound(previousEdgePoints_.begin(), previousEdgePoints_.end(), key,
+	                                 [](const EdgePoint& entry, std::uint64_t k) { return entry.pair < k; });
+	KeptEdgePoint kept;
+	if (it == previousEdgePoints_.end() || it->pair != key) return kept;
+	kept.onA = it->block == a;
+	kept.edge = it->edge;
+	kept.otherEdge = it->otherEdge;
+	kept.point = it->point;
+	return kept;
+}
+
 void ContactStore::setEntrance(int a, int b, const EntranceFeature& entrance) {
 	const std::uint64_t key = pairKey(a, b);
 	if (!entrances_.empty() && key <= entrances_.back().first) entrancesSorted_ = false;
@@ -209,10 +231,11 @@ void ContactStore::clear() {
 	entrancesSorted_ = true;
 	previousEntrances_.clear();
 	claimed_.clear();
+	previousEdgePoints_.clear();
 }
 
 std::size_t ContactStore::memoryBytes() const {
-	return capacityBytes(current_) + capacityBytes(previous_) + capacityBytes(claimed_) +
+	return capacityBytes(current_) + capacityBytes(previous_) + capacityBytes(claimed_) + capacityBytes(previousEdgePoints_) +
 	       capacityBytes(previousIndex_.slots) + capacityBytes(byFeature1_.slots) + capacityBytes(sameFeature1_) +
 	       capacityBytes(entrances_) + capacityBytes(previousEntrances_);
 }

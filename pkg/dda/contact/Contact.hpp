@@ -135,6 +135,11 @@ public:
 	// Entrance features of block pairs (a < b) from the last detection.
 	const EntranceFeature& previousEntrance(int a, int b) const;
 	void setEntrance(int a, int b, const EntranceFeature& entrance);
+	// The near-parallel edge contact of blocks a and b of the last step (an
+	// edge-edge key with a vertex-face stencil), onA when its point lies on
+	// an edge of block a; edge = -1 when the pair had none. Built from the
+	// contacts themselves, so a loaded state gives the same.
+	KeptEdgePoint previousEdgePoint(int a, int b) const;
 
 	void clear();
 	// Heap bytes held: the capacities of the contact arrays, the indexes of
@@ -186,6 +191,15 @@ private:
 	mutable bool entrancesSorted_ = true;
 	std::vector<std::pair<std::uint64_t, EntranceFeature>> previousEntrances_;
 	std::vector<char> claimed_;  // previous contacts already inherited this step
+	// The last step's near-parallel edge contacts by pair key (the first of
+	// a pair's in contact order): the block owning the point's edge, the two
+	// edges and the point at the end of the step.
+	struct EdgePoint {
+		std::uint64_t pair;
+		int block, edge, otherEdge;
+		Vector3 point;
+	};
+	std::vector<EdgePoint> previousEdgePoints_;
 };
 
 }  // namespace dda

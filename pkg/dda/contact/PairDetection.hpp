@@ -225,6 +225,16 @@ struct EntranceFeature {
 	}
 };
 
+// The pair's near-parallel edge contact of the last step (SubContacts.cpp,
+// nearParallelEdgeContact): the edge its point lies on (of block A when onA,
+// else of B), the other block's edge, and where that point ended the step
+// [m]. edge = -1: none.
+struct KeptEdgePoint {
+	bool onA = true;
+	int edge = -1, otherEdge = -1;
+	Vector3 point = Vector3::Zero();
+};
+
 struct DetectionSettings {
 	double contactDistance = 0;  // d0 [m], >= 0
 	double lengthTolerance = 0;  // [m], > 0: coincident corners, on-segment, inside-face tests
@@ -238,6 +248,9 @@ struct DetectionSettings {
 	// the strain-driven drift of corners that started coincident, far below
 	// the block's own features); lengthTolerance is used when larger.
 	double cornerMergeDistance = 0;
+	// Per pair: its near-parallel edge contact of the last step, whose point
+	// the contact keeps while it is at least half as deep as the deepest.
+	KeptEdgePoint keptEdgePoint;
 };
 
 // One vertex-face or edge-edge sub-contact. Blocks are called A and B (the

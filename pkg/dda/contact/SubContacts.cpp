@@ -914,7 +914,9 @@ struct DeepestEdgePoint {
 	double distance = std::numeric_limits<double>::infinity();  // h(t) [m], < 0 inside
 	int face = -1;  // the exposed face of `other` farthest above x(t), -1 when an internal face is
 };
-DeepestEdgePoint deepestEdgePoint(const Prepared& block, int e, const Prepared& other, double tolerance) {
+// With `at` in [0, 1], the point x(at) instead of the deepest.
+DeepestEdgePoint deepestEdgePoint(const Prepared& block, int e, const Prepared& other, double tolerance,
+                                  double at = -1) {
 	const Vector3& p0 = block.edgeStart(e);
 	const Vector3& p1 = block.edgeEnd(e);
 	const int faces = other.faceCount();
@@ -938,15 +940,19 @@ DeepestEdgePoint deepestEdgePoint(const Prepared& block, int e, const Prepared& 
 			out.t = t;
 		}
 	};
-	tryAt(0);
-	tryAt(1);
-	for (int g = 0; g < faces; ++g)
-		for (int k = g + 1; k < faces; ++k) {
-			const double denominator = slope[g] - slope[k];
-			if (denominator == 0) continue;
-			const double t = (at0[k] - at0[g]) / denominator;
-			if (t > 0 && t < 1) tryAt(t);
-		}
+	if (at >= 0 && at <= 1) {
+		tryAt(at);
+	} else {
+		tryAt(0);
+		tryAt(1);
+		for (int g = 0; g < faces; ++g)
+			for (int k = g + 1; k < faces; ++k) {
+				const double denominator = slope[g] - slope[k];
+				if (denominator == 0) continue;
+				const double t = (at0[k] - at0[g]) / denominator;
+				if (t > 0 && t < 1) tryAt(t);
+			}
+	}
 	// Its own entrance face: the exposed face it lies farthest above, unless
 	// an internal face lies above that by more than the tolerance (the point
 	// is then across a flush joint, held through the neighbour's faces).
@@ -1036,15 +1042,31 @@ DeepestEdgePoint deepestEdgePoint(const Prepared& block, int e, const Prepared& 
 // scenes raised, sum 3.06e6 J). An open contact for such a pair would have
 // to hold the line (its ends and the crossing), not a point.
 std::optional<SubContact> nearParallelEdgeContact(const Prepared& a, int edgeA, const Prepared& b, int edgeB,
-                                                  double tolerance, double lowest) {
+                                                  double depth, double tolerance, double lowest,
+                                                  const KeptEdgePoint& kept) {
 	const DeepestEdgePoint inB = deepestEdgePoint(a, edgeA, b, tolerance);
 	const DeepestEdgePoint inA = deepestEdgePoint(b, edgeB, a, tolerance);
-	const bool useA = inA.distance < inB.distance;  // B's edge in A; ties: A's edge in B
-	const DeepestEdgePoint& deepest = useA ? inA : inB;
+	bool useA = inA.distance < inB.distance;  // B's edge in A; ties: A's edge in B
+	DeepestEdgePoint deepest = useA ? inA : inB;
+	// The last step's point, a material point of its edge, while it lies at
+	// least half as deep as the deepest point (keptEdgePoint).
+	if (kept.edge == (kept.onA ? edgeA : edgeB) && kept.otherEdge == (kept.onA ? edgeB : edgeA)) {
+		const Prepared& owner = kept.onA ? a : b;
+		const Vector3 start = owner.edgeStart(kept.edge), along = owner.edgeEnd(kept.edge) - start;
+		const double length2 = along.squaredNorm();
+		const double t = length2 > 0 ? along.dot(kept.point - start) / length2 : -1;
+		if (t >= 0 && t <= 1) {
+			const DeepestEdgePoint held = deepestEdgePoint(owner, kept.edge, kept.onA ? b : a, tolerance, t);
+			if (held.face >= 0 && held.distance < 0 && held.distance <= 0.5 * deepest.distance) {
+				deepest = held;
+				useA = !kept.onA;
+			}
+		}
+	}
 	const Prepared& blockI = useA ? b : a;
 	const Prepared& blockJ = useA ? a : b;
 	const int edgeI = useA ? edgeB : edgeA, edgeJ = useA ? edgeA : edgeB;
-	if (deepest.face < 0 || !(deepest.distance < -tolerance)) return std::nullopt;
+	if (deepest.face < 0 || !(deepest.distance < -depth)) return std::nullopt;
 	const Vector3 x = blockI.edgeStart(edgeI) + deepest.t * (blockI.edgeEnd(edgeI) - blockI.edgeStart(edgeI));
 	const FacePlane& plane = blockJ.faces[deepest.face];
 	SubContact c;
@@ -1056,7 +1078,7 @@ std::optional<SubContact> nearParallelEdgeContact(const Prepared& a, int edgeA, 
 	                              blockJ.corner(plane.corners[2]));
 	bool valid = false;
 	c.gap = stencilGap(c.stencil, valid);
-	if (!valid || !(c.gap < -tolerance) || c.gap < lowest) return std::nullopt;
+	if (!valid || !(c.gap < -depth) || c.gap < lowest) return std::nullopt;
 	c.normal = plane.normal;
 	c.pointI = x;
 	c.pointJ = x - c.gap * plane.normal;
@@ -1141,11 +1163,17 @@ void findSubContacts(const Prepared& a, const Prepared& b, const std::vector<Fac
 		tiedFaceContacts(a, b, faces, axes, depthBound, crossingBound, settings, sinTolerance, s, entrance, out);
 	// Near-parallel edges that overlap, with no sub-contact pushing the pair
 	// apart (nearParallelEdgeContact; the argument at the top of this file).
+	// Made once the pair overlaps by more than lengthTolerance, the contact is
+	// kept while it overlaps at all (keptEdgePoint).
 	const double pairSeparation = std::max(depthBound, axes.nearParallelBest);
-	if (axes.nearParallelEdgeA >= 0 && pairSeparation < -tol &&
+	const KeptEdgePoint& kept = settings.keptEdgePoint;
+	const bool keep = kept.edge >= 0 && kept.edge == (kept.onA ? axes.nearParallelEdgeA : axes.nearParallelEdgeB) &&
+	                  kept.otherEdge == (kept.onA ? axes.nearParallelEdgeB : axes.nearParallelEdgeA);
+	const double depth = keep ? 0.0 : tol;
+	if (axes.nearParallelEdgeA >= 0 && pairSeparation < -depth &&
 	    std::none_of(out.contacts.begin(), out.contacts.end(), [](const SubContact& c) { return c.gap < 0; })) {
 		const std::optional<SubContact> c = nearParallelEdgeContact(a, axes.nearParallelEdgeA, b, axes.nearParallelEdgeB,
-		                                                            tol, pairSeparation - tol);
+		                                                            depth, tol, pairSeparation - tol, kept);
 		if (c) out.contacts.push_back(*c);
 	}
 }

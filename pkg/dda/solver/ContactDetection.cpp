@@ -259,8 +259,9 @@ void ContactDetection::detectChunk(Step& step, int begin, int count, int chunk) 
 				pairFound_[q] = 0;
 				continue;
 			}
-			const DetectionSettings detection =
+			DetectionSettings detection =
 			    pairDetectionSettings(diagonals_[a], diagonals_[b], stats.contactDistance, stats.allowedDisplacement);
+			detection.keptEdgePoint = step.store.previousEdgePoint(a, b);
 			const std::vector<char>* internalA = internalFaces_[a].empty() ? nullptr : &internalFaces_[a];
 			const std::vector<char>* internalB = internalFaces_[b].empty() ? nullptr : &internalFaces_[b];
 			const std::vector<FaceCover>* coverA = covers_[a].empty() ? nullptr : &covers_[a];

@@ -472,6 +472,77 @@ TEST(ContactDetection, NearParallelEdgesCrossingInsideHaveAContactAsDeepAsTheirO
 			}
 }
 
+// The same crossing ridges (theta = 0.01, delta = 1e-3): the depth of a
+// point of a ridge inside the other prism falls linearly from delta / sqrt(2)
+// at the crossing to half that at |x| theta = delta / 2 along it. The pair's
+// near-parallel contact of the last step (keptEdgePoint) keeps its point, a
+// material point of its edge, while that point lies at least half as deep as
+// the crossing: at 0.3 delta / theta from the crossing its gap is -0.7 delta
+// / sqrt(2); at 0.6 delta / theta the crossing's point is taken. And a pair
+// overlapping by less than lengthTolerance has the contact only when it had
+// it (made at the tolerance, kept while it overlaps): a contact made and
+// dropped at one threshold came back compressed every other step in a
+// jointed mass at rest.
+TEST(ContactDetection, NearParallelEdgeContactKeepsItsPointWhileHalfAsDeep) {
+	const Block a = prismAlongX(-1, 1, 0);
+	const Block b0 = prismAlongX(-0.5, 0.5, 2);
+	const double theta = 0.01;
+	for (const Scene& scene : genericScenes(71, 3)) {
+		const Block aMoved = moved(a, scene.R, scene.o);
+		const auto place = [&](double delta) {
+			return moved(b0, scene.R * rotationAbout(Vector3::UnitZ(), theta), scene.R * Vector3(0, 0, -delta) + scene.o);
+		};
+		const auto nearParallel = [](const PairContacts& r) {
+			return std::find_if(r.contacts.begin(), r.contacts.end(), [](const SubContact& c) {
+				return c.kind == ContactKind::EdgeEdge && c.stencil.kind == ContactKind::VertexFace;
+			});
+		};
+		DetectionSettings s = settings(1e-3);
+		s.angleTolerance = 0.05;
+		const double delta = 1e-3;
+		const Block b = place(delta);
+		const std::optional<PairContacts> first = detect(aMoved, b, s);
+		ASSERT_TRUE(first.has_value());
+		const auto c0 = nearParallel(*first);
+		ASSERT_NE(c0, first->contacts.end()) << describe(*first);
+		ASSERT_NEAR(c0->gap, -delta / std::sqrt(2.0), 1e-9);
+		// The edge the point lies on, through the crossing.
+		const Block& owner = c0->firstIsA ? aMoved : b;
+		const std::array<int, 2> ends = owner.shape.edges[c0->feature1];
+		const Vector3 along = (owner.vertices[ends[1]] - owner.vertices[ends[0]]).normalized();
+		for (const double share : {0.3, 0.6}) {
+			SCOPED_TRACE("kept point at " + std::to_string(share) + " delta / theta");
+			s.keptEdgePoint = {c0->firstIsA, c0->feature1, c0->feature2, c0->pointI + share * delta / theta * along};
+			const std::optional<PairContacts> r = detect(aMoved, b, s);
+			ASSERT_TRUE(r.has_value());
+			checkInvariants(*r, aMoved, b, s);
+			const auto c = nearParallel(*r);
+			ASSERT_NE(c, r->contacts.end()) << describe(*r);
+			if (share < 0.5) {
+				EXPECT_LT((c->pointI - s.keptEdgePoint.point).norm(), 1e-9);
+				EXPECT_NEAR(c->gap, -(1 - share) * delta / std::sqrt(2.0), 1e-8);
+			} else {
+				EXPECT_LT((c->pointI - c0->pointI).norm(), 1e-9);
+				EXPECT_NEAR(c->gap, -delta / std::sqrt(2.0), 1e-9);
+			}
+		}
+		// Overlapping by half the tolerance: none made, one kept.
+		const double shallow = 0.5 * s.lengthTolerance;
+		const Block c = place(shallow);
+		s.keptEdgePoint = {};
+		const std::optional<PairContacts> fresh = detect(aMoved, c, s);
+		ASSERT_TRUE(fresh.has_value());
+		EXPECT_EQ(nearParallel(*fresh), fresh->contacts.end()) << describe(*fresh);
+		s.keptEdgePoint = {c0->firstIsA, c0->feature1, c0->feature2, c0->pointI};
+		const std::optional<PairContacts> kept = detect(aMoved, c, s);
+		ASSERT_TRUE(kept.has_value());
+		const auto k = nearParallel(*kept);
+		ASSERT_NE(k, kept->contacts.end()) << describe(*kept);
+		EXPECT_LT(k->gap, 0);
+		EXPECT_GE(k->gap, -shallow - s.lengthTolerance);
+	}
+}
+
 // ------------------------------------------------------------------ edge-face
 
 TEST(ContactDetection, EdgeFaceExactPrismOnFloor) {
