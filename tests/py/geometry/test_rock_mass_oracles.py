@@ -385,7 +385,8 @@ AT_REST_SPEED = 1e-3   # [m/s] every free block slower than this at the end
 REST_RUNS = ([('junctions', 0, 5.0, 0.2), ('oblique', 1, SIDE, 0.2)]
              + [pytest.param(kind, seed, SIDE, 0.5, marks=pytest.mark.slow)
                 for kind in ('oblique', 'orthogonal') for seed in (1, 2, 3, 4, 5)]
-             + [pytest.param('junctions', 0, 5.0, 0.5, marks=pytest.mark.slow)])
+             + [pytest.param('junctions', 0, 5.0, 0.5, marks=pytest.mark.slow)]
+             + [pytest.param(kind, 1, 6.0, 0.5, marks=pytest.mark.slow) for kind in ('oblique', 'orthogonal')])
 
 
 @functools.lru_cache(maxsize=None)
