@@ -1043,23 +1043,24 @@ DeepestEdgePoint deepestEdgePoint(const Prepared& block, int e, const Prepared& 
 // to hold the line (its ends and the crossing), not a point.
 std::optional<SubContact> nearParallelEdgeContact(const Prepared& a, int edgeA, const Prepared& b, int edgeB,
                                                   double depth, double tolerance, double lowest,
-                                                  const KeptEdgePoint& kept) {
+                                                  const KeptEdgePoint* kept) {
 	const DeepestEdgePoint inB = deepestEdgePoint(a, edgeA, b, tolerance);
 	const DeepestEdgePoint inA = deepestEdgePoint(b, edgeB, a, tolerance);
 	bool useA = inA.distance < inB.distance;  // B's edge in A; ties: A's edge in B
 	DeepestEdgePoint deepest = useA ? inA : inB;
 	// The last step's point, a material point of its edge, while it lies at
-	// least half as deep as the deepest point (keptEdgePoint).
-	if (kept.edge == (kept.onA ? edgeA : edgeB) && kept.otherEdge == (kept.onA ? edgeB : edgeA)) {
-		const Prepared& owner = kept.onA ? a : b;
-		const Vector3 start = owner.edgeStart(kept.edge), along = owner.edgeEnd(kept.edge) - start;
+	// least half as deep as the deepest point (keptEdgePoint; given only
+	// for these two edges).
+	if (kept) {
+		const Prepared& owner = kept->onA ? a : b;
+		const Vector3 start = owner.edgeStart(kept->edge), along = owner.edgeEnd(kept->edge) - start;
 		const double length2 = along.squaredNorm();
-		const double t = length2 > 0 ? along.dot(kept.point - start) / length2 : -1;
+		const double t = length2 > 0 ? along.dot(kept->point - start) / length2 : -1;
 		if (t >= 0 && t <= 1) {
-			const DeepestEdgePoint held = deepestEdgePoint(owner, kept.edge, kept.onA ? b : a, tolerance, t);
+			const DeepestEdgePoint held = deepestEdgePoint(owner, kept->edge, kept->onA ? b : a, tolerance, t);
 			if (held.face >= 0 && held.distance < 0 && held.distance <= 0.5 * deepest.distance) {
 				deepest = held;
-				useA = !kept.onA;
+				useA = !kept->onA;
 			}
 		}
 	}
@@ -1173,7 +1174,7 @@ void findSubContacts(const Prepared& a, const Prepared& b, const std::vector<Fac
 	if (axes.nearParallelEdgeA >= 0 && pairSeparation < -depth &&
 	    std::none_of(out.contacts.begin(), out.contacts.end(), [](const SubContact& c) { return c.gap < 0; })) {
 		const std::optional<SubContact> c = nearParallelEdgeContact(a, axes.nearParallelEdgeA, b, axes.nearParallelEdgeB,
-		                                                            depth, tol, pairSeparation - tol, kept);
+		                                                            depth, tol, pairSeparation - tol, keep ? &kept : nullptr);
 		if (c) out.contacts.push_back(*c);
 	}
 }
