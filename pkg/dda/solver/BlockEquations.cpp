@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include <Eigen/Eigenvalues>
+
 namespace dda {
 
 namespace {
@@ -28,6 +30,17 @@ void addOwnLoads(const Block& block, const IntegratorSettings& settings, Force&&
 		    displacementMatrix(load.position - block.centroid).template leftCols<N>().transpose() * load.force;
 }
 }  // namespace
+
+double strainViscosity(const Block& block, double zeta) {
+	if (zeta <= 0 || block.rigid) return 0;
+	// The second moments' largest eigenvalue (3x3, closed form) per unit volume [m^2].
+	Eigen::SelfAdjointEigenSolver<Matrix3> moments;
+	moments.computeDirect(block.secondMoment, Eigen::EigenvaluesOnly);
+	const double j = moments.eigenvalues()(2) / block.volume;
+	const double shearModulus = block.material.young / (2 * (1 + block.material.poisson));
+	const double omega = std::sqrt(2 * shearModulus / (block.density() * j));
+	return 2 * zeta / omega;
+}
 
 Vector12 restForce(const Block& block, const IntegratorSettings& settings) {
 	Vector12 force = Vector12::Zero();
@@ -75,6 +88,10 @@ void assembleBlock(const Block& block, const IntegratorSettings& settings, doubl
 	addInertia(mass, v0, a0, settings, dt, system.stiffness, system.force);
 
 	system.stiffness.block<6, 6>(6, 6).noalias() += block.referenceVolume() * block.elasticity();
+	if (settings.strainDamping > 0)
+		system.stiffness.block<6, 6>(6, 6).noalias() +=
+		    (strainViscosity(block, settings.strainDamping) / (settings.newmarkGamma * dt) * block.referenceVolume()) *
+		    block.elasticity();
 	system.force.segment<6>(6).noalias() -= block.volume * block.stress;
 
 	addOwnLoads<12>(block, settings, system.force, &system.stiffness);

@@ -45,6 +45,43 @@
 
 namespace dda {
 
+// Strain viscosity (IntegratorSettings::strainDamping, zeta). A deformable
+// block's strain rates carry the Kelvin-Voigt stress eta E d(eps)/dt. Over a
+// step the mean strain rate is eps/dt (the trapezoidal rule), so the step's
+// mean viscous force is G_v = -(eta/dt) V0 E eps: in the system (normalised
+// by gamma, as the contacts' mean forces) K_ee += (eta / (gamma dt)) V0 E.
+// Its work D . G_v = -(eta/dt) V0 eps^T E eps <= 0 is dissipated and booked
+// as damping (World::accountStep): it never creates energy, and it adds a
+// convex quadratic to the step's energy (line search and passes unchanged).
+// eta = 2 zeta / omega_ref [s], omega_ref = sqrt(2 G / (rho j)) with G the
+// shear modulus, rho the current density and j the largest eigenvalue of
+// the second moments per unit volume: for boxes of any proportions and
+// Poisson's ratio the block's lowest elastic (free-free strain) frequency
+// is 1 to 1.22 omega_ref, so that mode is damped at zeta to 1.22 zeta and
+// higher ones more. It acts on strain rates only: rigid motion and steady
+// strain (a block sliding or at rest) feel nothing, and quasi-static results
+// are those without it.
+//
+// Why: a DDA block is one constant-strain element, and on contact springs
+// with Coulomb friction its strain modes and the friction form a flutter
+// (mode-coupling) instability while it slides. The friction's pull at the
+// base stretches the block (E_xx) where the front and back normal forces
+// differ, Poisson's ratio turns the stretch into a height change that moves
+// every normal force, and the total friction's moment about the centroid
+// turns the base again: a loop that is not symmetric (the friction force
+// follows the normal displacement, not the tangential), so two modes merge
+// into a growing pair. Without Poisson coupling, with rigid blocks or
+// without friction there is none. A linear analysis of a sliding box
+// (12 unknowns, four corner springs, friction along the slip) finds growth
+// rates up to 0.3 omega_ref at friction 40 deg, and viscosity removes
+// them at zeta 0.41 (worst of random boxes 0.3..3 m, Poisson 0..0.45,
+// friction 5..40 deg, contactPenaltyFactor 40). Shi's scheme damps a mode
+// of frequency omega at a rate of about omega^2 dt / 2, so it hid the
+// instability at dt 1e-2 s and lost it as dt fell: a pushed block rocked
+// on its corners at dt 1e-4 and 1e-5 s and ran 29 % and 66 % ahead of
+// Coulomb's closed form.
+double strainViscosity(const Block& block, double zeta);
+
 struct BlockSystem {
 	Matrix12 stiffness;
 	Vector12 force;

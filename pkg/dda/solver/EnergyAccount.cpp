@@ -21,7 +21,7 @@ EnergyAccount World::energy() const {
 	return account;
 }
 
-void World::accountStep(const IntegratorSettings& settings) {
+void World::accountStep(const IntegratorSettings& settings, double dt) {
 	// Blocks. Shi's scheme (v1 = 2D/dt - v0, (2/dt^2) M D = (2/dt) M v0 + F(D))
 	// gives 1/2 v1^T M v1 - 1/2 v0^T M v0 = F(D) . D exactly: the kinetic
 	// energy changes by the work of the end-of-step forces over D. Gravity's
@@ -56,8 +56,13 @@ void World::accountStep(const IntegratorSettings& settings) {
 		e.scaling = ratio < 1 ? (1 - ratio * ratio) * kineticEnergy(block, block.velocity) : 0;
 		e.strained = !block.rigid;
 		if (e.strained) {
+			// (2 gamma - 1) times the Bregman divergence, plus the strain
+			// viscosity's work (eta/dt) V0 eps^T E eps (BlockEquations.hpp).
 			const Vector6 strain = D.segment<6>(6);
-			e.strain = (2 * gamma - 1) * 0.5 * block.referenceVolume() * strain.dot(block.elasticity() * strain);
+			const double elastic = block.referenceVolume() * strain.dot(block.elasticity() * strain);
+			e.strain = (2 * gamma - 1) * 0.5 * elastic;
+			if (settings.strainDamping > 0)
+				e.strain += strainViscosity(block, settings.strainDamping) / dt * elastic;
 		}
 		e.loaded = !block.loads.empty() || !block.fixedPoints.empty();
 	}

@@ -31,7 +31,7 @@ struct EnergyAccount {
 	double strain = 0;    // V/2 sigma^T E^-1 sigma (the blocks' elastic energy, initial stress included)
 	double contact = 0;   // energy in the closed contacts' springs at the end of the last step
 	double friction = 0;  // dissipated by sliding (work of friction loads against the relative motion)
-	double damping = 0;   // dissipated by the time scheme (and by velocityRatio < 1)
+	double damping = 0;   // dissipated by the time scheme, the strain viscosity and velocityRatio < 1
 	double loads = 0;     // work done on the blocks by point loads and fixed-point springs
 	// Energy the contacts' springs gained between the end of one step and the
 	// start of the next (D = 0 of the next step in its accepted states): new

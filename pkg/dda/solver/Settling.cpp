@@ -180,6 +180,9 @@ void World::settle(const IntegratorSettings& settings) {
 	statics.velocityRatio = 0;
 	statics.newmarkBeta = 0.5;
 	statics.newmarkGamma = 1;
+	// Static steps seek an equilibrium, which no viscosity moves; left out,
+	// the settled state is the same with or without it.
+	statics.strainDamping = 0;
 	statics.timeStepGrowth = 1;
 	statics.maxOpenCloseIterations = std::max(settings.maxOpenCloseIterations, kSettleOpenCloseIterations);
 	const double longest = settlingTimeStep(blocks_, settings);

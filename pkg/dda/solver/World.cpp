@@ -241,7 +241,7 @@ double World::advance(const IntegratorSettings& settings) {
 	const double dt = solveStep(settings, stats);
 
 	gravity_ = settings.gravity;
-	accountStep(settings);
+	accountStep(settings, dt);
 	moveContactsAndBlocks(settings, dt, stats);
 
 	timeStep_.stepTaken(settings, dt, stats.maxDisplacement, stats.allowedDisplacement);

@@ -172,7 +172,7 @@ private:
 	// Adds the accepted step's dissipation, work of loads and contact springs'
 	// changes to the account (energy_), and records the springs' energy at its
 	// end; called before the contacts and blocks are moved (EnergyAccount.cpp).
-	void accountStep(const IntegratorSettings& settings);
+	void accountStep(const IntegratorSettings& settings, double dt);
 
 	std::unique_ptr<Collider> collider_ = std::make_unique<DESSCollider>();
 	ContactStore store_;

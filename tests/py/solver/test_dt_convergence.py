@@ -71,6 +71,9 @@ blocks (E < 5e7) converge in dt to an error of a few %, from the elastic ringing
 the release of the settled (friction-locked) state starts. These two mechanisms are
 reported as expected failures, each only where it is seen (a base corner open or the
 base tilted; a block softer than 5e7 Pa with its base flat); any other failure fails.
+The rocking is a flutter of the constant-strain block on friction (doc/DESIGN.md,
+"Strain viscosity and friction-driven flutter"): DDAIntegrator(strainDamping=0.5)
+removes it (tests/py/solver/test_strain_viscosity.py); these runs use the default.
 
 Default run: SEEDS (14 s on an idle machine, 25 s on a loaded one); `-m slow` adds
 SLOW_SEEDS (20 of each case; all 44 cases 2.3 minutes idle, about 4 loaded).
