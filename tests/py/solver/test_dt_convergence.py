@@ -35,12 +35,14 @@ bounds (and within 0..h), a case with no room is redrawn. For the sliding block,
 Start from rest is on (the default): the block settles on loaded contacts before the
 first step. Each case runs at dt = 1e-2, 1e-3, 1e-4 and 1e-5 s to T2 = 0.3 s
 (DDAIntegrator(dt=dt, maxDisplacement=0.05): the block moves at most 15 mm in a 1e-2 s
-step, so no step is cut), and its centroid's displacement along x between T1 = 0.1 s
-and T2 is compared with a (t2^2 - t1^2) / 2 on the actual O.time values. Oracles, per
-case:
+step, so no step is cut), with the default strain viscosity (strainDamping 0.5). Two
+measures against the closed form: the centroid's displacement along x between T1 = 0.1 s
+and T2, against a (t2^2 - t1^2) / 2 on the actual O.time values, and its acceleration,
+fitted (least squares, x0 + v0 t + a t^2 / 2) to the positions sampled every 5 ms over
+T1..T2. Oracles, per case:
 
-- the relative error is within 1 % at every dt;
-- it does not grow as dt falls: |err(dt / 10)| <= |err(dt)| + 0.2 %;
+- the relative errors of both are within 1 % at every dt;
+- they do not grow as dt falls: |err(dt / 10)| <= |err(dt)| + 0.2 %;
 - the block does not rock: the tilt of its base (the plane through its four corners,
   sampled every 5 ms) stays below 1e-4 rad. Its rotation (block(b).rotation) is
   printed but not bounded: for a deformable block it holds half its elastic shear
@@ -48,32 +50,32 @@ case:
 - it moves sideways (y, the set-up is symmetric in y) less than 1e-6 m;
 - no step is cut: O.time reaches T2 in T2 / dt steps.
 
-Each run prints a table row: case, seed, E, dt, relative error, largest rotation, and,
-to tell a failure's mechanism, the largest tilt of the base (the plane through its four
-corners), the largest angular speed, the sideways drift and the number of base corners
-open at T2. The case's line gives the rotation its elastic shear alone would show: the
-friction at the base shears a deformable block whose base stays flat on the floor, and
-DDA's rotation of a block in simple shear is half its shear strain, about
+Each run prints a table row: case, seed, E, dt, the two relative errors, largest
+rotation, and, to tell a failure's mechanism, the largest tilt of the base (the plane
+through its four corners), the largest angular speed, the sideways drift and the number
+of base corners open at T2. The case's line gives the rotation its elastic shear alone
+would show: the friction at the base shears a deformable block whose base stays flat on
+the floor, and DDA's rotation of a block in simple shear is half its shear strain, about
 rho g cos(slope) e / (2 G) (the first moment of the contact forces, N e, over the volume,
 over twice the shear modulus): 1e-4 rad and more for the softest blocks, while their
 base's tilt stays a few 1e-5.
 
-What the sweep finds: every case drawn is consistent with its closed form: the same
-blocks made rigid (rigid=True) follow it within 0.17 % at dt 1e-3 and 1e-5 with
-rotations below 1.7e-5 rad. The deformable blocks do not: 19 of 22 pushed and 11 of 22
-sliding cases fail, the error always positive (the block runs ahead: less friction than
-tan(phi) N on average). Pushed blocks of E 1e8..1e11 start a friction-driven rocking and
-bouncing (all four base corners open at times) that grows as dt falls: the scheme's
-numerical damping, large at dt 1e-2, vanishes; average acceleration shows it at every
-dt; without friction there is none. Sliding blocks show its onset at dt 1e-5 (seed 122,
-E 1.05e9: the error grows from 0.17 to 0.39 %, all four corners open at 0.3 s). Soft
-blocks (E < 5e7) converge in dt to an error of a few %, from the elastic ringing that
-the release of the settled (friction-locked) state starts. These two mechanisms are
-reported as expected failures, each only where it is seen (a base corner open or the
-base tilted; a block softer than 5e7 Pa with its base flat); any other failure fails.
-The rocking is a flutter of the constant-strain block on friction (doc/DESIGN.md,
-"Strain viscosity and friction-driven flutter"): DDAIntegrator(strainDamping=0.5)
-removes it (tests/py/solver/test_strain_viscosity.py); these runs use the default.
+What the sweep finds (all 44 cases): no block rocks (largest base tilt 1.4e-5 rad, no
+corner open) and every acceleration is within 0.23 % of Coulomb's at dt 1e-2 s and
+0.055 % at the finer steps, not growing. All 22 blocks on an incline follow the closed
+form's displacement within 0.22 % at every dt but one soft block (E 1.25e7 Pa). Pushed
+blocks leave the start ahead: the locked state the start from rest leaves a block that
+must slide holds the block's elastic strain under the push, which relaxes as it starts
+and gives it speed (doc/DESIGN.md, "Strain viscosity and friction-driven flutter"); 9
+of 22 (E 7.2e7 to 3.1e9 Pa) run 0.4 to 2.5 % ahead at the finer steps where Shi's
+damping at dt 1e-2 s hides it, so their displacement error grows from dt 1e-2 to 1e-3.
+Those are reported as expected failures when the acceleration passes and the block
+neither rocks nor is cut, and so are soft blocks (E < 5e7 Pa, 3 pushed and 1 on an
+incline, up to 7.5 %: the elastic ringing the release of the settled state starts);
+any other failure fails. Without the strain viscosity the deformable blocks' friction
+flutter makes them rock, more as dt falls (BlockEquations.hpp): 19 of 22 pushed and 11 of
+22 sliding blocks failed, one by 66 % at dt 1e-5 s; rigid blocks (rigid=True) follow
+the closed form within 0.17 % at dt 1e-3 and 1e-5 with rotations below 1.7e-5 rad.
 
 Default run: SEEDS (14 s on an idle machine, 25 s on a loaded one); `-m slow` adds
 SLOW_SEEDS (20 of each case; all 44 cases 2.3 minutes idle, about 4 loaded).
@@ -224,8 +226,14 @@ def run(case, dt):
     base = [i for i, v in enumerate(blk.vertices) if abs(v[2]) < 1e-9]
     assert len(base) == 4, base
     most = dict(rotation=0.0, tilt=0.0, spin=0.0, sideways=0.0)
+    # (t, x) of the centroid from T1 on, for the acceleration, taken by the PyRunner only: it runs
+    # within a step, after the blocks moved and before O.time advances, so every t is the same
+    # dt early, which the fit's free velocity absorbs.
+    track = []
 
-    def sample():
+    def sample(tracked=True):
+        if tracked and O.time >= T1 - 1e-9:
+            track.append((O.time, blk.centroid[0]))
         most['rotation'] = max(most['rotation'], blk.rotation.toRotationVector().norm())
         most['tilt'] = max(most['tilt'], base_tilt(blk, base))
         most['spin'] = max(most['spin'], math.sqrt(sum(w * w for w in blk.velocity[3:6])))
@@ -239,23 +247,28 @@ def run(case, dt):
         t1, c1 = O.time, blk.centroid[0]
         O.run(int(round(T2 / dt)) - int(round(T1 / dt)), True)
         t2, c2 = O.time, blk.centroid[0]
-        sample()
+        sample(tracked=False)
     finally:
         del builtins._ddaConvergenceSample
     expected = 0.5 * acceleration(case) * (t2 ** 2 - t1 ** 2)
     opened = sum(1 for c in yade_dda.contacts() if block in (c.id1, c.id2) and c.state == 'open')
+    # The acceleration: x = x0 + v0 t + a t^2 / 2 fitted (least squares) to the samples from T1 to T2.
+    t, x = np.array(track).T
+    fitted = np.linalg.lstsq(np.c_[np.ones_like(t), t - T1, 0.5 * (t - T1) ** 2], x, rcond=None)[0][2]
     return dict(kind=case['kind'], seed=case['seed'], E=case['E'], dt=dt, error=(c2 - c1) / expected - 1,
-                opened=opened, t2=t2, moved=c2 - c1, expected=expected, **most)
+                accelerationError=fitted / acceleration(case) - 1, opened=opened, t2=t2, moved=c2 - c1,
+                expected=expected, **most)
 
 
-HEADER = '%-8s %4s %9s %7s %11s %10s %10s %10s %10s %5s' % ('case', 'seed', 'E [Pa]', 'dt [s]', 'rel. error',
-                                                           'rot. [rad]', 'tilt [rad]', 'w [rad/s]', 'y [m]', 'open')
+HEADER = '%-8s %4s %9s %7s %11s %11s %10s %10s %10s %10s %5s' % (
+    'case', 'seed', 'E [Pa]', 'dt [s]', 'rel. error', 'acc. error', 'rot. [rad]', 'tilt [rad]', 'w [rad/s]', 'y [m]',
+    'open')
 
 
 def row(r):
-    return '%-8s %4d %9.3g %7.0e %+11.3e %10.2e %10.2e %10.2e %10.2e %5d' % (
-        r['kind'], r['seed'], r['E'], r['dt'], r['error'], r['rotation'], r['tilt'], r['spin'], r['sideways'],
-        r['opened'])
+    return '%-8s %4d %9.3g %7.0e %+11.3e %+11.3e %10.2e %10.2e %10.2e %10.2e %5d' % (
+        r['kind'], r['seed'], r['E'], r['dt'], r['error'], r['accelerationError'], r['rotation'], r['tilt'],
+        r['spin'], r['sideways'], r['opened'])
 
 
 def check(case):
@@ -263,8 +276,11 @@ def check(case):
     rows = [run(case, dt) for dt in DTS]
     table = '\n'.join([describe(case), HEADER] + [row(r) for r in rows])
     print(table)
-    problems = []
+    problems, accelerationProblems = [], []
     for r in rows:
+        if abs(r['accelerationError']) > TOLERANCE:
+            accelerationProblems.append('dt %g: acceleration error %+.3e beyond %g'
+                                        % (r['dt'], r['accelerationError'], TOLERANCE))
         if abs(r['t2'] - T2) > 1e-9:
             problems.append('dt %g: steps were cut (O.time %.9f after T2/dt steps)' % (r['dt'], r['t2']))
         if abs(r['error']) > TOLERANCE:
@@ -277,15 +293,20 @@ def check(case):
         if abs(fine['error']) > abs(coarse['error']) + GROWTH:
             problems.append('error grew from %+.3e at dt %g to %+.3e at dt %g'
                             % (coarse['error'], coarse['dt'], fine['error'], fine['dt']))
-    if not problems:
+        if abs(fine['accelerationError']) > abs(coarse['accelerationError']) + GROWTH:
+            accelerationProblems.append('acceleration error grew from %+.3e at dt %g to %+.3e at dt %g'
+                                        % (coarse['accelerationError'], coarse['dt'], fine['accelerationError'],
+                                           fine['dt']))
+    if not problems and not accelerationProblems:
         return
-    message = '%s seed=%d: %s\n%s' % (case['kind'], case['seed'], '; '.join(problems), table)
+    message = '%s seed=%d: %s\n%s' % (case['kind'], case['seed'], '; '.join(accelerationProblems + problems), table)
     cut = any(abs(r['t2'] - T2) > 1e-9 for r in rows) or any(r['sideways'] >= MAX_SIDEWAYS for r in rows)
-    if not cut and any(r['opened'] or r['tilt'] >= MAX_TILT for r in rows):
-        pytest.xfail('friction-driven rocking of a deformable block (base corners open or its base tilted), '
-                     'growing as dt falls: ' + message)
-    if not cut and case['E'] < SOFT:
+    rocked = any(r['opened'] or r['tilt'] >= MAX_TILT for r in rows)
+    if not cut and not rocked and case['E'] < SOFT:
         pytest.xfail('a soft block rings elastically once the settled state is released: ' + message)
+    if not cut and not rocked and not accelerationProblems:
+        pytest.xfail('the block accelerates at Coulomb\'s rate but left the start ahead (the locked start '
+                     'state\'s elastic strain released): ' + message)
     pytest.fail(message)
 
 

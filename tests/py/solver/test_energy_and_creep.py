@@ -499,16 +499,19 @@ def test_wedge_given_by_dips_below_fs_one_slides_as_coulomb_says(scene, dt):
     assert across < 1e-3 * expected
 
 
+@pytest.mark.parametrize('zeta', [0.0, 0.5], ids=['undamped', 'viscous'])
 @pytest.mark.parametrize('scheme', [(0.5, 1.0), (0.25, 0.5)])
-def test_energy_account_is_exact_for_a_block_vibrating_at_finite_strain(scene, scheme):
+def test_energy_account_is_exact_for_a_block_vibrating_at_finite_strain(scene, scheme, zeta):
     """A free deformable block released from a random initial stress up to 0.3 E
-    (strains of 30%, volume swinging by 15-20%) and spun at a random rate, no
-    gravity and no contacts, 1000 steps under Shi's scheme and under average
-    acceleration. Oracle: the account's sum (kinetic + strain + damping) stays its
-    start value to 1e-10 of the largest term: the step changes the strain energy
-    V0/2 tau E^-1 tau by exactly the elastic work, and the rates' kinetic energy
-    carries over to the moved block exactly (BlockEquations.hpp, "Finite strain").
-    Before, the account drifted by up to 44% of the strain energy here."""
+    (strains of 30%, volume swinging by 15-20% without strain viscosity) and spun at
+    a random rate, no gravity and no contacts, 1000 steps under Shi's scheme and under
+    average acceleration, without and with strain viscosity (strainDamping 0.5).
+    Oracle: the account's sum (kinetic + strain + damping) stays its start value to
+    1e-10 of the largest term: the step changes the strain energy V0/2 tau E^-1 tau
+    by exactly the elastic work, the viscosity's work is booked as damping, and the
+    rates' kinetic energy carries over to the moved block exactly (BlockEquations.hpp,
+    "Finite strain"). Before, the account drifted by up to 44% of the strain energy
+    here."""
     rng = random.Random(SEED + 17)
     print('seed', SEED + 17)
     mat = O.materials.append(wrapper.PolyhedraMat(density=1000, young=1e6, poisson=0.3))
@@ -517,7 +520,7 @@ def test_energy_account_is_exact_for_a_block_vibrating_at_finite_strain(scene, s
     b = O.bodies.append(yade_dda.ddaBlock(pts, material=mat, stress=stress))
     yade_dda.setVelocity(b, (0, 0, 0), [rng.uniform(-3, 3) for _ in range(3)])
     beta, gamma = scheme
-    O.engines = [DDAIntegrator(gravity=(0, 0, 0), dt=1e-3, newmarkBeta=beta, newmarkGamma=gamma)]
+    O.engines = [DDAIntegrator(gravity=(0, 0, 0), dt=1e-3, newmarkBeta=beta, newmarkGamma=gamma, strainDamping=zeta)]
     O.step()
     a0 = yade_dda.stats()['energy']
     volumes, biggest, worst = [], 0.0, 0.0
@@ -527,7 +530,7 @@ def test_energy_account_is_exact_for_a_block_vibrating_at_finite_strain(scene, s
         volumes.append(yade_dda.block(b).volume)
         biggest = max(biggest, a['strain'], a['kinetic'])
         worst = max(worst, abs(account(a) - account(a0)))
-    assert max(volumes) - min(volumes) > 0.1 * 0.35, (min(volumes), max(volumes))  # finite strain indeed
+    assert max(volumes) - min(volumes) > (0.1 if zeta == 0 else 0.02) * 0.35, (min(volumes), max(volumes))  # finite strain indeed
     assert worst <= 1e-10 * biggest, (worst, biggest)
 
 
@@ -548,8 +551,11 @@ def test_no_step_turns_a_block_inside_out(scene):
     stored energy grows without bound as the volume goes to zero)."""
     b = _prestressed_soft_block(5)
     volume = yade_dda.block(b).volume
-    cut = 0
     O.step()
+    cut = yade_dda.stats()['stepCuts']
+    v = yade_dda.block(b).volume
+    assert 0 < v and v >= 0.5 * volume * (1 - 1e-12), (O.iter, v, volume)
+    volume = v
     a0 = yade_dda.stats()['energy']
     for _ in range(20):
         O.step()

@@ -25,6 +25,8 @@ from helpers import box, material
 G = 9.81
 DENSITY = 2600.0
 AVERAGE = dict(newmarkBeta=0.25, newmarkGamma=0.5)
+# Average acceleration without the strain viscosity: nothing in a block dissipates.
+ELASTIC = dict(AVERAGE, strainDamping=0.0)
 
 
 def mechanical(e):
@@ -132,7 +134,8 @@ def test_rigid_bounce_under_average_acceleration_keeps_its_energy(scene):
 
 
 def test_deformable_bounce_under_average_acceleration_keeps_its_energy(scene):
-    """Average acceleration, a deformable cube (E = 1 GPa): over 5 bounces the
+    """Average acceleration without strain viscosity (strainDamping=0), a deformable cube
+    (E = 1 GPa): over 5 bounces the
     mechanical energy (with the strain energy and the strain rates' kinetic energy,
     which the impacts excite and this scheme does not damp) keeps at least 95% of
     the drop energy (85% is required) and never rises above its start by more
@@ -142,7 +145,7 @@ def test_deformable_bounce_under_average_acceleration_keeps_its_energy(scene):
     second order in the strain that Shi's scheme damps and this one carries from
     vibration to vibration. A rigid cube, without them, keeps its energy to 1e-11
     (test_rigid_bounce_under_average_acceleration_keeps_its_energy)."""
-    apexes, high, low, drift = drop(False, 1e-3, 3.3, AVERAGE)
+    apexes, high, low, drift = drop(False, 1e-3, 3.3, ELASTIC)
     print('apexes', apexes, 'high', high, 'low', low, 'drift', drift)
     assert len(apexes) >= 5, apexes
     assert high < 5e-3 and low > -5e-2 and drift < 5e-2, (high, low, drift)

@@ -310,7 +310,7 @@ def test_slender_block_sliding(scene, motion):
     new corner contacts must slide from the first step: held locked for a
     step, they tip the block over its long edge); a linearised gap over a
     6 m lever penetrates. On the frictionless floor the block must keep its
-    velocity (to 1e-6 m/s and 1e-6 rad/s: nothing resists); on the
+    velocity (to 1e-6 m/s horizontally and 1e-6 rad/s: nothing resists); on the
     frictional one it must stop after v^2 / (2 g tan(phi)) within 1% (it
     stops at 0.35 s); on the incline it must follow
     g (sin a - tan(phi) cos a) t^2 / 2 within 1%; it must stay flat (turned
@@ -344,7 +344,12 @@ def test_slender_block_sliding(scene, motion):
         assert abs(slid - expected) < 0.01 * expected, (slid, expected)
     else:
         expected = (speed, 0, 0) if motion == 'lengthwise' else (0, speed, 0)
-        assert S.norm(S.sub(v[:3], expected)) < 1e-6
+        assert math.hypot(v[0] - expected[0], v[1] - expected[1]) < 1e-6
+        # Vertically the block, launched as placed (not settled), still rings on its
+        # contact springs as its weight loads them: 4e-7 m/s at 0.5 s without strain
+        # viscosity, 1.3e-6 m/s with it (the thin directions' overdamped strain slows
+        # the decay).
+        assert abs(v[2]) < 1e-5
         assert S.norm(v[3:6]) < 1e-6
     assert yade_dda.block(block).rotation.toRotationVector().norm() < 1e-4
 
