@@ -154,7 +154,7 @@ def test_a_tunnel_in_concave_blocks_keeps_its_account_and_its_loose_block_falls_
     # with it (strainDamping 0.5; 1.1e-5 at 0.4, below 1e-5 at 0.1 to 0.3), lost 0.1 to 0.3 J at a
     # time in every other step while two to seven contacts slide and a step takes 24 solves in five
     # limit passes (the same losses, fewer and smaller, without viscosity). The viscosity's own
-    # booking is exact (test_energy_account_is_exact_for_a_block_vibrating_at_finite_strain[viscous],
+    # booking is exact (test_energy_account_is_exact_for_a_block_vibrating_at_finite_strain[scheme0-viscous],
     # tests/py/solver/test_strain_viscosity.py); the source of this residual is open. 3e-5 bounds it.
     assert abs(account(e) - account(e0)) < 3e-5 * scale, (account(e) - account(e0), scale)
     # What detection gives the springs stays within 1e-4 of the largest change. The bursts it had came from

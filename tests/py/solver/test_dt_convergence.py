@@ -183,8 +183,9 @@ def acceleration(case):
     return G * (math.sin(a) - mu * math.cos(a))
 
 
-def build(case, dt):
-    """The case's floor and block in a fresh scene, its integrator at dt; returns the block's id."""
+def build(case, dt, **integrator):
+    """The case's floor and block in a fresh scene, its integrator at dt (further DDAIntegrator
+    parameters in `integrator`); returns the block's id."""
     O.reset()
     Lx, Ly, Lz = case['sides']
     rock = O.materials.append(wrapper.PolyhedraMat(density=DENSITY, young=case['E'], poisson=POISSON,
@@ -201,7 +202,7 @@ def build(case, dt):
     # threads=1: results do not depend on the count, and one block gains nothing from a second
     # thread, which on a shared machine only waits
     O.engines = [DDAIntegrator(dt=dt, gravity=(G * math.sin(a), 0.0, -G * math.cos(a)),
-                               maxDisplacement=MAX_DISPLACEMENT, threads=1, label='dda')]
+                               maxDisplacement=MAX_DISPLACEMENT, threads=1, label='dda', **integrator)]
     return block
 
 

@@ -30,6 +30,7 @@ from yade_dda import O, DDAIntegrator
 from yade import wrapper
 
 from helpers import box
+from test_dt_convergence import base_tilt, build, draw_pushed  # the sweep's pushed block
 
 DENSITY = 2600.0
 AVERAGE = dict(newmarkBeta=0.25, newmarkGamma=0.5)
@@ -164,28 +165,12 @@ def test_rigid_motion_and_steady_sliding_feel_no_viscosity(scene):
     assert deformable1 == pytest.approx(deformable0, rel=0.005)
 
 
-def base_tilt(blk, base):
-    p = np.array([tuple(blk.vertices[i]) for i in base])
-    A = np.c_[p[:, 0] - p[:, 0].mean(), p[:, 1] - p[:, 1].mean(), np.ones(len(p))]
-    sx, sy, _ = np.linalg.lstsq(A, p[:, 2], rcond=None)[0]
-    return math.atan(math.hypot(sx, sy))
-
-
 def pushed_tilt(zeta, dt=1e-4, duration=0.15):
-    """A 1.268 x 1.926 x 0.716 m block (E 1.77e8 Pa, 38.97 deg of friction) pushed at
-    1.24 x its friction limit at (0.519, 0, 0.418) m of its frame; returns the largest tilt
-    of its base [rad] and its relative error against Coulomb's acceleration."""
-    O.reset()
-    Lx, Ly, Lz = 1.268, 1.926, 0.716
-    phi = math.radians(38.97)
-    rock = O.materials.append(wrapper.PolyhedraMat(density=DENSITY, young=1.77e8, poisson=0.25, frictionAngle=phi))
-    O.bodies.append(yade_dda.ddaBlock(box((-3, -Ly / 2 - 2, -1), (Lx + 5, Ly / 2 + 2, 0)), material=rock, fixed=True))
-    mass = DENSITY * Lx * Ly * Lz
-    force = 1.24 * math.tan(phi) * mass * 9.81
-    b = O.bodies.append(yade_dda.ddaBlock(box((0, -Ly / 2, 0), (Lx, Ly / 2, Lz)), material=rock,
-                                          loads=[((0.519, 0, 0.418), (force, 0, 0))]))
-    O.engines = [DDAIntegrator(dt=dt, gravity=(0, 0, -9.81), maxDisplacement=0.05, threads=1, strainDamping=zeta)]
-    blk = yade_dda.block(b)
+    """The pushed block of test_dt_convergence.py's seed 1 (1.268 x 1.926 x 0.716 m, E 1.77e8
+    Pa, 38.97 deg of friction, pushed at 1.24 x its friction limit) with strainDamping zeta;
+    returns the largest tilt of its base [rad] over `duration`, sampled every 5 ms."""
+    block = build(draw_pushed(1), dt, strainDamping=zeta)
+    blk = yade_dda.block(block)
     base = [i for i, v in enumerate(blk.vertices) if abs(v[2]) < 1e-9]
     tilt = 0.0
     for _ in range(int(round(duration / 0.005))):
