@@ -289,6 +289,7 @@ py::dict lastStep(const SceneLink& s) {
 	d["iterativeIterations"] = st.iterativeIterations;
 	d["iterativeFallbacks"] = st.iterativeFallbacks;
 	d["limitPasses"] = st.limitPasses;
+	d["limitsLowered"] = st.limitsLowered;
 	d["limitsUnsettled"] = st.limitsUnsettled;
 	d["settleSteps"] = st.settleSteps;
 	d["settledBlocks"] = st.settledBlocks;

@@ -311,8 +311,10 @@ def stats():
     (later solves of a step done by conjugate gradients preconditioned with
     the step's first factorisation, their iterations, and those that fell
     back to a factorisation; DDAIntegrator's refineSolves),
-    ``limitPasses`` and ``limitsUnsettled`` (friction-limit passes after the
-    first; groups of touching blocks accepted with limits still moving).
+    ``limitPasses``, ``limitsLowered`` and ``limitsUnsettled`` (friction-limit
+    passes after the first; groups of touching blocks whose limits did not
+    settle and ended Coulomb-safe, no friction above tan(phi) N; groups the
+    start from rest's static steps accepted with limits still moving).
     ``settleSteps``, ``settledBlocks``, ``settleConverged``: the start from
     rest before the first step (DDAIntegrator's startFromRest): static steps
     made (0: nothing to settle), blocks brought to equilibrium, and whether

@@ -313,6 +313,33 @@ double limitForceChange(const Contact& contact) {
 	return std::abs(std::min(spring, target) - std::min(spring, before));
 }
 
+double limitExcess(const Contact& contact) {
+	const double before = contact.slipLimit;
+	if (!(before > 0)) return 0.0;
+	const double target = slipLimit(contact, contact.trial.normalForce);
+	if (contact.trial.bonded) return std::max(0.0, before - target);
+	const double spring = contact.shearStiffness * contact.stretch.norm();
+	return std::max(0.0, std::min(spring, before) - std::min(spring, target));
+}
+
+double forceScale(const Contact& contact) {
+	const double carried = std::min(contact.shearStiffness * contact.stretch.norm(), contact.slipLimit);
+	return std::max(slipLimit(contact, contact.trial.normalForce), carried);
+}
+
+void setFrictionLimit(Contact& contact) {
+	const double target = slipLimit(contact, contact.trial.normalForce);
+	contact.limitChange = target - contact.slipLimit;
+	contact.slipLimit = target;
+}
+
+void lowerFrictionLimit(Contact& contact) {
+	const double target = slipLimit(contact, contact.trial.normalForce);
+	if (!(target < contact.slipLimit)) return;
+	contact.limitChange = target - contact.slipLimit;
+	contact.slipLimit = target;
+}
+
 Vector3 tangentialForce(const Contact& contact, const Block& blockI, const Block& blockJ, const Vector12& Di,
                         const Vector12& Dj) {
 	const TangentialTerm tangential = tangentialTerm(contact);

@@ -117,6 +117,27 @@ bool evaluateContact(Contact& contact, const Block& blockI, const Block& blockJ,
 // before the move [N]. Without `apply` only returns it.
 double updateFrictionLimit(Contact& contact, bool apply);
 
+// How far the contact's tangential force at its trial state exceeds what
+// Coulomb allows at its normal force now [N]: min(ks |s|, L) - min(ks |s|,
+// L') when positive, L' = tan(phi) max(N, 0) (+ c A while bonded); 0 for a
+// contact whose force its new limit would keep or raise. (No limit yet: 0.)
+double limitExcess(const Contact& contact);
+
+// Lowers the contact's friction limit to tan(phi) max(N, 0) (+ c A while
+// bonded) for its normal force now, when that is below it; never raises it.
+void lowerFrictionLimit(Contact& contact);
+
+// Sets the contact's friction limit to tan(phi) max(N, 0) (+ c A while bonded)
+// for its normal force now, up or down.
+void setFrictionLimit(Contact& contact);
+
+// The tangential force the contact may carry at its trial state [N]: the
+// larger of Coulomb's limit at its normal force now, tan(phi) max(N, 0)
+// (+ c A while bonded), and the force its spring carries, min(ks |s|, L).
+// (Not the limit L itself: an open contact keeps the limit of a normal force
+// that has gone for the rest of its pass.)
+double forceScale(const Contact& contact);
+
 // A contact that slips with static friction's limit (Contact::staticFriction
 // > 1) goes over to Coulomb's: its friction tangent loses the factor. The
 // limit follows at the next pass (measureLimits, startPasses).

@@ -81,7 +81,8 @@ struct StepStatistics {
 	int iterativeIterations = 0;     // its conjugate-gradient iterations (all attempts)
 	int iterativeFallbacks = 0;      // iterative solves that did not converge and were factorised (all attempts)
 	int limitPasses = 0;             // passes made after the first because friction limits changed (all attempts)
-	int limitsUnsettled = 0;         // attempts accepted with limits still changing after kLimitPasses passes
+	int limitsLowered = 0;           // groups whose limits did not settle and whose later passes only lowered them (all attempts)
+	int limitsUnsettled = 0;         // groups accepted with limits unsettled (a friction force above tan(phi) N) (all attempts)
 	// start from rest (IntegratorSettings::startFromRest): the settling before the
 	// first step, in every step's report
 	int settleSteps = 0;             // static steps the settling took (0: none was tried)

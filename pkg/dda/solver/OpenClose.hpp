@@ -56,6 +56,9 @@ public:
 	// its ramp): the passes' limit test then compares the limits
 	// themselves, not the tangential forces they would move (measureLimits).
 	void setScaledFriction(bool scaled) { scaledFriction_ = scaled; }
+	// Whether limits that do not settle end Coulomb-safe (closePasses; off
+	// in World::settle's static steps, which accept them as they stand).
+	void setCoulombSafe(bool safe) { coulombSafe_ = safe; }
 	// The solver's heap [bytes] (World::MemoryUse::solver, World's motions aside).
 	std::size_t memoryBytes() const;
 
@@ -81,8 +84,10 @@ private:
 	// Groups whose pass converged: their limits against the normal forces found.
 	void measureLimits(std::vector<Contact>& contacts);
 	// Which groups are done, which start a new pass; returns whether all are
-	// done, adds the state changes of the groups still iterating to changes.
-	bool closePasses(int iterations, const Attempt& attempt, int& changes);
+	// done, adds the state changes of the groups still iterating to changes,
+	// and sets `exhausted` when a group has made its last solve (solveBudget)
+	// without converging.
+	bool closePasses(int iterations, const Attempt& attempt, int& changes, bool& exhausted);
 	// The limits of the groups starting a new pass; returns whether the
 	// structure changed.
 	bool startPasses(const Attempt& attempt);
@@ -131,6 +136,8 @@ private:
 	std::vector<unsigned char> keptTermsKey_;  // per contact: the state its kept terms are for
 	bool keepTerms_ = true;
 	bool scaledFriction_ = false;
+	bool coulombSafe_ = true;
+
 	// Newmark's start acceleration a0 of each moving block (unless Shi's
 	// scheme, which does not read it): M^-1 times the block's own forces at
 	// D = 0 (restForce). Contacts are left out: they enter as the step's mean
@@ -161,7 +168,9 @@ private:
 	// Per group of the step's iteration (indexed by root).
 	struct GroupIteration {
 		std::vector<char> done, hasContacts, swungBack, newPass;
-		std::vector<int> passes, passSolves, changes;
+		// coulombSafe: 0 while the group's passes settle its limits, then
+		// 1 + the Coulomb-safe passes it has started (closePasses).
+		std::vector<int> passes, passSolves, changes, coulombSafe;
 		// limitChange: relative to its contacts' scales, or (scaled friction)
 		// in newtons against largestLimit.
 		std::vector<double> forceChange, largestNormalForce, limitChange, largestLimit;

@@ -190,6 +190,7 @@ void World::settle(const IntegratorSettings& settings) {
 	settling_ = true;
 	frictionScale_ = kSettleFrictionScale;
 	openClose_.setScaledFriction(true);
+	openClose_.setCoulombSafe(false);
 	frozen_.clear();
 	settleSteps_ = 0;
 	settleConverged_ = false;
@@ -202,6 +203,7 @@ void World::settle(const IntegratorSettings& settings) {
 	}
 	settling_ = false;
 	openClose_.setScaledFriction(false);
+	openClose_.setCoulombSafe(true);
 	frictionScale_ = 1;
 	frozen_.clear();
 	if (settledBlocks_ == 0) settleSteps_ = 0;  // nothing to settle: not tried

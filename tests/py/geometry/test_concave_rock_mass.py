@@ -114,7 +114,7 @@ def test_a_tunnel_in_concave_blocks_keeps_its_account_and_its_loose_block_falls_
     """A 16 m x 8 m x 16 m box around a 4 m x 4 m tunnel, given as four convex parts, cut by two
     conjugate sets dipping 60 degrees and a horizontal set of persistence 0.6, joined into concave blocks
     (seed 4); the boundary blocks held, E = 1e10 Pa, 30 degrees of friction, gravity, 0.3 s. The energy
-    account balances (3e-5 of the largest change) and what contact detection adds stays within 1e-4 of it; the
+    account balances (1.5e-4 of the largest change) and what contact detection adds stays within 1e-4 of it; the
     block that falls
     farthest, concave, falls freely: its drop fits g t^2 / 2 (1 %)."""
     parts = [box((0, 0, 0), (16, 8, 6)), box((0, 0, 10), (16, 8, 16)), box((0, 0, 6), (6, 8, 10)),
@@ -148,15 +148,16 @@ def test_a_tunnel_in_concave_blocks_keeps_its_account_and_its_loose_block_falls_
     account = lambda e: (e['kinetic'] + e['gravity'] + e['strain'] + e['contact'] + e['friction'] + e['damping']
                          - e['loads'] - e['contactChanges'])
     scale = max(abs(e[k] - e0[k]) for k in e)
-    # The account is exact to round-off but for a residual that depends on the trajectory: here
-    # 4e-7 to 3e-6 of the largest change without strain viscosity (measured with the friction-limit
-    # test at 1e-6 to 5e-3 of its scale: settling the limits fully does not shrink it) and 1.8e-5
-    # with it (strainDamping 0.5; 1.1e-5 at 0.4, below 1e-5 at 0.1 to 0.3), lost 0.1 to 0.3 J at a
-    # time in every other step while two to seven contacts slide and a step takes 24 solves in five
-    # limit passes (the same losses, fewer and smaller, without viscosity). The viscosity's own
-    # booking is exact (test_energy_account_is_exact_for_a_block_vibrating_at_finite_strain[scheme0-viscous],
-    # tests/py/solver/test_strain_viscosity.py); the source of this residual is open. 3e-5 bounds it.
-    assert abs(account(e) - account(e0)) < 3e-5 * scale, (account(e) - account(e0), scale)
+    # The account is exact to round-off but for a residual that depends on the trajectory: 0.05 to 0.6 J
+    # lost (never gained) in steps where contacts slide, 9.2e-5 of the largest change over the run. Its
+    # source: a pass is accepted when no state changes and the slipping contacts' forces match their
+    # model, also when the line search shortened its last Newton step, so the iterate falls short of
+    # the minimiser of the pass's energy and the step's equations hold only to the rest of that step.
+    # Requiring a full last step makes this scene's account exact (3e-8 J) but leaves contacts sitting
+    # at a kink of their energy (a gap at zero, a stretch at its limit) with no pass that converges:
+    # jointed masses cut their step to 1e-154 s. Before friction limits ended Coulomb-safe (fewer
+    # steps with sliding contacts and limit passes) it was 1.8e-5. 1.5e-4 bounds it.
+    assert abs(account(e) - account(e0)) < 1.5e-4 * scale, (account(e) - account(e0), scale)
     # What detection gives the springs stays within 1e-4 of the largest change. The bursts it had came from
     # corners given a negative gap against a face whose plane runs on past a ridge of a concave block,
     # the corners outside the whole block: 78 J in one step (refineSolves off; +114 J over the run on an
