@@ -81,8 +81,8 @@ struct StepStatistics {
 	int iterativeIterations = 0;     // its conjugate-gradient iterations (all attempts)
 	int iterativeFallbacks = 0;      // iterative solves that did not converge and were factorised (all attempts)
 	int limitPasses = 0;             // passes made after the first because friction limits changed (all attempts)
-	int limitsLowered = 0;           // groups whose limits did not settle and whose later passes only lowered them (all attempts)
-	int limitsUnsettled = 0;         // groups accepted with limits unsettled (a friction force above tan(phi) N) (all attempts)
+	int limitsLowered = 0;           // groups whose limits did not settle and that went on in Coulomb-safe passes (all attempts)
+	int limitsUnsettled = 0;         // groups start from rest's static steps accepted with limits unsettled (all attempts)
 	// start from rest (IntegratorSettings::startFromRest): the settling before the
 	// first step, in every step's report
 	int settleSteps = 0;             // static steps the settling took (0: none was tried)

@@ -19,8 +19,8 @@ namespace {
 constexpr double kNewtonTolerance = 1e-10;
 // A step's friction limits are consistent with its normal forces when moving
 // every limit to its normal force's would move no contact's tangential
-// force by more than this fraction of its blocks' force scale (forceScale,
-// measureLimits; limitForceChange: a contact inside both its old and its new cone keeps
+// force by more than this fraction of its blocks' force scale (forceScale;
+// limitForceChange: a contact inside both its old and its new cone keeps
 // its force, so its limit does not count; measureLimits); a step makes at
 // most kLimitPasses passes (see solve()). Per block, that is at least as
 // tight as the group test it replaces (1e-3 of the group's largest limit)
@@ -450,8 +450,8 @@ void OpenCloseIteration::GroupIteration::startIteration() {
 }
 
 std::size_t OpenCloseIteration::GroupIteration::memoryBytes() const {
-	return capacityBytes(done) + capacityBytes(hasContacts) + capacityBytes(swungBack) + capacityBytes(newPass) + capacityBytes(coulombSafe) +
-	       capacityBytes(passes) + capacityBytes(passSolves) + capacityBytes(changes) + capacityBytes(forceChange) +
+	return capacityBytes(done) + capacityBytes(hasContacts) + capacityBytes(swungBack) + capacityBytes(newPass) +
+	       capacityBytes(coulombSafe) + capacityBytes(passes) + capacityBytes(passSolves) + capacityBytes(changes) + capacityBytes(forceChange) +
 	       capacityBytes(largestNormalForce) + capacityBytes(limitChange) + capacityBytes(largestLimit);
 }
 

@@ -137,7 +137,6 @@ private:
 	bool keepTerms_ = true;
 	bool scaledFriction_ = false;
 	bool coulombSafe_ = true;
-
 	// Newmark's start acceleration a0 of each moving block (unless Shi's
 	// scheme, which does not read it): M^-1 times the block's own forces at
 	// D = 0 (restForce). Contacts are left out: they enter as the step's mean
