@@ -334,10 +334,7 @@ void setFrictionLimit(Contact& contact) {
 }
 
 void lowerFrictionLimit(Contact& contact) {
-	const double target = slipLimit(contact, contact.trial.normalForce);
-	if (!(target < contact.slipLimit)) return;
-	contact.limitChange = target - contact.slipLimit;
-	contact.slipLimit = target;
+	if (slipLimit(contact, contact.trial.normalForce) < contact.slipLimit) setFrictionLimit(contact);
 }
 
 Vector3 tangentialForce(const Contact& contact, const Block& blockI, const Block& blockJ, const Vector12& Di,

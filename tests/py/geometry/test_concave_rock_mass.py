@@ -155,8 +155,9 @@ def test_a_tunnel_in_concave_blocks_keeps_its_account_and_its_loose_block_falls_
     # the minimiser of the pass's energy and the step's equations hold only to the rest of that step.
     # Requiring a full last step makes this scene's account exact (3e-8 J) but leaves contacts sitting
     # at a kink of their energy (a gap at zero, a stretch at its limit) with no pass that converges:
-    # jointed masses cut their step to 1e-154 s. Before friction limits ended Coulomb-safe (fewer
-    # steps with sliding contacts and limit passes) it was 1.8e-5. 1.5e-4 bounds it.
+    # jointed masses cut their step to 1e-154 s. With friction limits accepted as they stand when
+    # they do not settle (fewer steps with sliding contacts and limit passes) it is 1.8e-5.
+    # 1.5e-4 bounds it.
     assert abs(account(e) - account(e0)) < 1.5e-4 * scale, (account(e) - account(e0), scale)
     # What detection gives the springs stays within 1e-4 of the largest change. The bursts it had came from
     # corners given a negative gap against a face whose plane runs on past a ridge of a concave block,
