@@ -13,7 +13,7 @@ d0 and therefore the same contacts and the same trajectories; they differ in
 how much work the search takes (``stats()['time']['broadPhase']`` and
 ``['narrowPhase']``, ``stats()['candidatePairs']``). The command string
 carries every parameter, so an engine that comes back from
-``O.save()``/``O.load()`` as a plain PyRunner still selects the same strategy.
+``O.save()``/``O.load()`` (as a plain PyRunner) is made again from it (typedengines.py).
 """
 from ._yade import O, wrapper
 from . import _core

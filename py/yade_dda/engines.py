@@ -3,7 +3,8 @@
 YADE runs Python from engines only through ``PyRunner``; each engine here is a
 ``PyRunner`` subclass whose command calls the compiled core once per step.
 The command string carries every parameter, so an engine that comes back from
-``O.save()``/``O.load()`` as a plain PyRunner still knows its settings.
+``O.save()``/``O.load()`` (YADE saves it as a plain PyRunner) is made again from it
+(typedengines.py).
 """
 import ast
 import sys

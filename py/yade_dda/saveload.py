@@ -69,7 +69,11 @@ def afterLoad(before):
     """What the wrapped loads do once YADE has read a scene: forget the core
     scenes of the replaced and of the loaded token (both are stale now), then
     rebuild the loaded scene's DDA state from its tag. A scene with DDA blocks
-    but no saved state loads with a warning; DDA calls then raise."""
+    but no saved state loads with a warning; DDA calls then raise. The
+    yade_dda engines, which YADE loads as plain PyRunners, get their classes
+    back (typedengines.typedEngines)."""
+    from .typedengines import typedEngines
+    typedEngines()
     loaded = currentToken()
     for token in (before, loaded):
         if token:
