@@ -93,6 +93,8 @@ class DDAScene:
         for part, member in enumerate(spec.members):
             self.core.linkBody(index + part, member.id, member.state.pos, member.state.ori, list(member.shape.v))
         self.core.linkClump(index, clumpId, clump.state.ori)
+        if spec.fixed:
+            clump.dynamic = False   # as its members: YADE's tools (unbalancedForce, Newton) then skip it
         # The clump's state when a script set it after appendClumped, else what concaveBlock was given.
         state = clump.state if (clump.state.vel.norm() > 0 or clump.state.angVel.norm() > 0) else \
             spec.members[0].state

@@ -249,6 +249,25 @@ def test_unbalanced_force_is_yades_with_ddas_gravity():
     assert yade.utils.unbalancedForce is hooks.unbalancedForce
 
 
+def test_unbalanced_force_falls_beside_a_fixed_concave_block():
+    """A cube resting on a floor beside a fixed L-shaped block: the L's clump is
+    not dynamic (as its members and every fixed block), so neither YADE's
+    unbalancedForce nor ours counts its weight as an unbalanced force; the
+    resting cube reads about 0 (it read 1.4 when the clump counted)."""
+    from yade_dda import hooks
+    rock = material(O, young=1e8)
+    O.bodies.append(yade_dda.ddaBlock(box((-3, -3, -1), (3, 3, 0)), material=rock, fixed=True))
+    parts = [box((1.2, 0, 0), (2.2, 1, 1)), box((1.2, 1, 0), (2.2, 2, 1)), box((2.2, 1, 0), (3, 2, 1))]
+    clump, _ = O.bodies.appendClumped(yade_dda.concaveBlock(parts, material=rock, fixed=True))
+    O.bodies.append(yade_dda.ddaBlock(box((0, 0, 0), (1, 1, 1)), material=rock))
+    O.engines = [yade_dda.DDAIntegrator(dt=1e-3, gravity=(0, 0, -G))]
+    O.run(300, True)
+    assert not O.bodies[clump].dynamic
+    assert utils.unbalancedForce() < 0.05
+    O.engines = O.engines + [wrapper.NewtonIntegrator(dead=True, mask=0, gravity=(0, 0, -G))]
+    assert hooks.unbalancedForce._yadeDDA() == pytest.approx(utils.unbalancedForce(), rel=1e-12)
+
+
 def test_a_dda_step_leaves_yades_thread_count_alone():
     """A DDA step with threads=1 taken by O.step() (in the calling thread) once left OpenMP's thread
     count at 1 there; O.reset() then made a scene whose ForceContainer YADE sized for one thread, and
