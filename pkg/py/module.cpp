@@ -266,6 +266,7 @@ py::dict lastStep(const SceneLink& s) {
 	py::dict energy;
 	energy["kinetic"] = account.kinetic;
 	energy["gravity"] = account.gravity;
+	energy["gravityChange"] = account.gravityChange;
 	energy["strain"] = account.strain;
 	energy["contact"] = account.contact;
 	energy["friction"] = account.friction;

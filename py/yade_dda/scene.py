@@ -326,8 +326,10 @@ def stats():
     started as placed), or those friction at its true value cannot hold (a
     block that must slide: the locked state was kept); empty when it settled.
     ``energy``: the energy account [J], each term from its own formula:
-    ``kinetic``, ``gravity`` (potential of the last step's gravity),
-    ``strain``, ``contact`` (springs of the closed contacts), and summed over
+    ``kinetic``, ``gravity`` (potential of the last step's gravity, -m g . c
+    summed over the moving blocks), ``gravityChange`` (the same less its value
+    at the blocks' initial centroids: 0 at the start, what ``O.energy``
+    shows), ``strain``, ``contact`` (springs of the closed contacts), and summed over
     the steps ``friction`` and ``damping`` (dissipated) and ``loads`` (work of
     point loads and fixed points); ``contactChanges`` is what the contacts'
     springs gained between steps (new penetrating contacts, gaps linearised

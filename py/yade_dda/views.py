@@ -37,7 +37,7 @@ from . import _core
 ENERGY_NAMES = (
     # (stats()['energy'] key, O.energy name, sign)
     ('kinetic', 'ddaKinetic', 1),                # current [J]
-    ('gravity', 'ddaGravity', 1),                # current potential [J]
+    ('gravityChange', 'ddaGravity', 1),          # potential relative to the blocks' initial places [J]
     ('strain', 'ddaStrain', 1),                  # current [J]
     ('contact', 'ddaContact', 1),                # current, the closed contacts' springs [J]
     ('friction', 'ddaFriction', 1),              # cumulative, dissipated [J]

@@ -60,6 +60,7 @@ struct Block {
 	std::vector<Vector3> initialVertices;           // as created [m]; saved, read by no step
 	std::vector<Vector3> vertices;                  // current positions [m]
 	Vector3 centroid = Vector3::Zero();             // [m]
+	Vector3 initialCentroid = Vector3::Zero();      // of initialVertices [m]; derived, not saved
 	double volume = 0;                              // [m^3]
 	Matrix3 secondMoment = Matrix3::Zero();         // integral of d d^T dV [m^5]
 	double mass = 0;                                // [kg], conserved

@@ -8,10 +8,11 @@ namespace dda {
 
 EnergyAccount World::energy() const {
 	EnergyAccount account = energy_;
-	account.kinetic = account.gravity = account.strain = 0;
+	account.kinetic = account.gravity = account.gravityChange = account.strain = 0;
 	for (const Block& block : blocks_) {
 		if (block.fixed) continue;
 		account.gravity -= block.mass * gravity_.dot(block.centroid);
+		account.gravityChange -= block.mass * gravity_.dot(block.centroid - block.initialCentroid);
 		account.kinetic += kineticEnergy(block, block.velocity);
 		if (!block.rigid && !block.stress.isZero())
 			// W = V0/2 tau^T E^-1 tau, tau = (V / V0) sigma (BlockEquations.hpp).

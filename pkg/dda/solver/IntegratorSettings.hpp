@@ -28,6 +28,7 @@ struct IntegratorSettings {
 struct EnergyAccount {
 	double kinetic = 0;   // 1/2 v^T M v, consistent mass: translation, rotation and strain rates
 	double gravity = 0;   // -m g . c, potential of the last step's gravity
+	double gravityChange = 0;  // -m g . (c - c0): the same relative to the blocks' initial centroids c0
 	double strain = 0;    // V/2 sigma^T E^-1 sigma (the blocks' elastic energy, initial stress included)
 	double contact = 0;   // energy in the closed contacts' springs at the end of the last step
 	double friction = 0;  // dissipated by sliding (work of friction loads against the relative motion)

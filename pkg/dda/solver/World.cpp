@@ -100,7 +100,7 @@ Block makeBlock(const std::vector<Vector3>& points, const Material& material, bo
 	block.vertices = polyhedron.vertices;
 	block.initialVertices = std::move(polyhedron.vertices);
 	block.shape = std::make_shared<const PolyhedronTopology>(std::move(static_cast<PolyhedronTopology&>(polyhedron)));
-	block.centroid = properties.centroid;
+	block.centroid = block.initialCentroid = properties.centroid;
 	block.volume = properties.volume;
 	block.secondMoment = properties.secondMoment;
 	block.mass = material.density * properties.volume;

@@ -13,6 +13,7 @@
 #include "World.hpp"
 #include "dda/collider/ColliderFactory.hpp"
 #include "dda/core/StateStream.hpp"
+#include "dda/geometry/MassProperties.hpp"
 
 #include <algorithm>
 #include <type_traits>
@@ -94,6 +95,7 @@ void writeBlock(StateWriter& out, const Block& b) {
 Block readBlock(StateReader& in) {
 	Block b;
 	ConvexPolyhedron shape = readShape(in);
+	b.initialCentroid = computeMassProperties(shape.vertices, shape.faces).centroid;
 	b.initialVertices = std::move(shape.vertices);
 	b.shape = std::make_shared<const PolyhedronTopology>(std::move(static_cast<PolyhedronTopology&>(shape)));
 	in.matrixVector(b.vertices, "current vertices");
