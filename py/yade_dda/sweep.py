@@ -30,9 +30,14 @@ imported (its directory is put first on their ``PYTHONPATH``).
 Progress: a line when a row starts on a worker and one when it ends (row,
 status, wall time [s], done/total). A row fails when YADE exits non-zero
 without "Yade: normal exit." (yade-batch's rule; a scene that raises), when
-it leaves no record, when it runs past ``--timeout`` [s], or when its worker
-died more often than Dask allows; each failure is reported with the path and
-the last lines of its log, and the command exits 1 (0 when every row passed).
+it runs past ``--timeout`` [s], or when its worker died more often than Dask
+allows; each failure is reported with the path and the last lines of its
+log, and the command exits 1 (0 when every row passed). A row that exits
+normally is done, as yade-batch has it, with or without a record: a scene
+writes one only if it asks to (``yade_dda.regression.Record``, which writes
+``<description>.json`` into ``$YADE_DDA_RECORDS``; doc/user-guide.md, "Batch
+regressions"). Rows done without one are named in the summary, and
+``examples/regression/check.py`` fails a row whose record is missing.
 
 Retries are Dask's own: when a worker dies (killed, out of memory, node
 lost) the scheduler resubmits the rows it was running to another worker, up
@@ -59,6 +64,9 @@ import uuid
 
 TOPIC = 'yade-dda-sweep'
 """Dask event topic on which a task says that its row started."""
+
+NO_RECORD = 'done (wrote no record)'
+"""Status of a row that exited normally without a record (done, as yade-batch has it; check.py fails it)."""
 
 LOG_LINES = 12
 """Lines of a failed row's log that are printed."""
@@ -290,8 +298,8 @@ def _storeResult(result, attempt, out):
         return 'FAILED', 'ran past the time limit and was killed'
     if result['exitStatus'] != 0 and not result['normalExit']:
         return 'FAILED', 'YADE exited with status %s' % result['exitStatus']
-    if result['record'] is None:
-        return 'FAILED', 'the scene wrote no record %s.json' % result['description']
+    if result['record'] is None:   # yade-batch's rule: a scene that exits normally is done
+        return NO_RECORD, None
     return 'done', None
 
 
@@ -387,8 +395,11 @@ def _report(specs, failed, out, wall, stream):
               file=stream)
         for text in logTail(_readText(path) or ''):
             print('      | ' + text, file=stream)
-    print('sweep: %d rows, %d done, %d failed%s; %.1f s wall; records and logs in %s'
-          % (len(specs), len(specs) - len(failed), len(failed),
+    bare = [spec['description'] for spec in specs if spec['line'] not in failed
+            and not os.path.isfile(os.path.join(out, spec['description'] + '.json'))]
+    print('sweep: %d rows, %d done%s, %d failed%s; %.1f s wall; records and logs in %s'
+          % (len(specs), len(specs) - len(failed), ' (%d wrote no record: %s)' % (len(bare), ', '.join(bare))
+             if bare else '', len(failed),
              ' (%s)' % ', '.join(byLine[l]['description'] for l in sorted(failed)) if failed else '', wall, out),
           file=stream, flush=True)
 
@@ -424,8 +435,14 @@ def runRows(specs, out, workers=None, scheduler=None, retries=3, stream=None, na
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog='python3 -m yade_dda.sweep', description=__doc__.split('\n\n')[0],
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(
+        prog='python3 -m yade_dda.sweep', description=__doc__.split('\n\n')[0],
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        epilog="A row is done when its scene exits normally (yade-batch's rule), failed when YADE exits non-zero, "
+               "runs past --timeout or loses its worker too often. Records are optional: a scene that is to be "
+               "checked writes one with yade_dda.regression.Record(...).write(), into $YADE_DDA_RECORDS, which the "
+               "sweep sets; rows done without one are named in the summary. examples/regression/check.py TABLE "
+               "--out's DIR then compares the records with their closed forms and references.")
     parser.add_argument('table', help='a yade-batch table with a !SCRIPT column')
     parser.add_argument('--out', required=True, help='directory of the records and logs (<description>.json, .log)')
     where = parser.add_mutually_exclusive_group()

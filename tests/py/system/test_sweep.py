@@ -11,7 +11,9 @@
   its second attempt writes the one record, which passes check.py.
 - In the same run a row whose scene raises is reported FAILED with the path
   and the last lines of its log (the exception), writes no record, and the
-  command exits 1; the other rows' records are written.
+  command exits 1; the other rows' records are written. A row whose scene
+  exits normally without writing a record is done, as yade-batch has it,
+  and named in the summary; check.py fails it.
 - An existing scheduler (`dask scheduler`, `dask worker` started apart, on
   the loopback): two rows of the quick table through its scheduler file.
 
@@ -39,11 +41,11 @@ SWEEP = [PYTHON, '-m', 'yade_dda.sweep']
 
 # A scene for the kill and the failure: with a marker path, its first attempt writes the marker
 # (its PID and its parent's, the worker's) and holds for holdSeconds; an attempt that finds the
-# marker records itself as attempt 2 at once. fail=1 raises.
+# marker records itself as attempt 2 at once. fail=1 raises; record=0 exits normally without a record.
 HOLD_SCENE = '''\
 import os, time
 from yade_dda import regression
-regression.readParamsFromTable(marker='', holdSeconds=0.0, fail=0)
+regression.readParamsFromTable(marker='', holdSeconds=0.0, fail=0, record=1)
 from yade.params.table import *
 if fail:
     raise RuntimeError('this row fails on purpose')
@@ -58,13 +60,15 @@ elif marker:
 rec = regression.Record()
 rec.closedForm('attempt', attempt, 2 if marker else 1, abs=0.5)   # the held attempt must never record
 rec.measure('pid', os.getpid())
-rec.write()
+if record:
+    rec.write()
 '''
 HOLD_TABLE = '''\
-description  !SCRIPT  marker   holdSeconds  fail
-killed-once  hold.py  '{marker}'  60        0
-raises       hold.py  *        *            1
-plain        hold.py  *        *            0
+description  !SCRIPT  marker   holdSeconds  fail  record
+killed-once  hold.py  '{marker}'  60        0     1
+raises       hold.py  *        *            1     1
+plain        hold.py  *        *            0     1
+norecord     hold.py  *        *            0     0
 '''
 
 
@@ -216,11 +220,23 @@ def test_a_failing_row_is_reported_with_its_log(killed):
     assert 'FAILED row %d raises: YADE exited with status 1; log %s ends:' % (line, log) in output, output
     report = output[output.index('FAILED row %d raises' % line):]
     assert 'RuntimeError: this row fails on purpose' in report
-    assert 'sweep: 3 rows, 2 done, 1 failed (raises)' in output
+    assert 'sweep: 4 rows, 3 done (1 wrote no record: norecord), 1 failed (raises)' in output
     assert os.path.exists(log) and not os.path.exists(os.path.join(out, 'raises.json'))
     assert os.path.exists(os.path.join(out, 'plain.json')) and os.path.exists(os.path.join(out, 'killed-once.json'))
     code, report = run_check(killed['table'], out)
     assert code == 1 and 'RuntimeError' in report           # check.py shows the end of the same log
+
+
+def test_a_row_that_exits_normally_without_a_record_is_done(killed):
+    """yade-batch's rule: a scene that exits normally is done; the sweep says it wrote no record (an
+    ordinary scene, not written for check.py), and check.py, which needs the record, fails that row."""
+    output, out = killed['output'], killed['out']
+    line = table_lines(killed['table'])['norecord']
+    assert 'row %d norecord: done (wrote no record), ' % line in output, output
+    assert 'FAILED row %d' % line not in output
+    assert os.path.exists(os.path.join(out, 'norecord.log')) and not os.path.exists(os.path.join(out, 'norecord.json'))
+    code, report = run_check(killed['table'], out, '--lines', str(line))
+    assert code == 1 and 'norecord' in report, report
 
 
 # ---------------------------------------------------------------- an existing scheduler
