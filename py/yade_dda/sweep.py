@@ -58,6 +58,7 @@ import socket
 import subprocess
 import sys
 import tempfile
+import textwrap
 import threading
 import time
 import uuid
@@ -438,11 +439,11 @@ def main(argv=None):
     parser = argparse.ArgumentParser(
         prog='python3 -m yade_dda.sweep', description=__doc__.split('\n\n')[0],
         formatter_class=argparse.RawDescriptionHelpFormatter,
-        epilog="A row is done when its scene exits normally (yade-batch's rule), failed when YADE exits non-zero, "
+        epilog=textwrap.fill("A row is done when its scene exits normally (yade-batch's rule), failed when YADE exits non-zero, "
                "runs past --timeout or loses its worker too often. Records are optional: a scene that is to be "
                "checked writes one with yade_dda.regression.Record(...).write(), into $YADE_DDA_RECORDS, which the "
                "sweep sets; rows done without one are named in the summary. examples/regression/check.py TABLE "
-               "--out's DIR then compares the records with their closed forms and references.")
+               "--out's DIR then compares the records with their closed forms and references.", 79))
     parser.add_argument('table', help='a yade-batch table with a !SCRIPT column')
     parser.add_argument('--out', required=True, help='directory of the records and logs (<description>.json, .log)')
     where = parser.add_mutually_exclusive_group()
