@@ -163,16 +163,7 @@ def _checkEngines(scene, engines):
     _guards.checkSingleIntegrator(engines)
     _guards.checkColliderOrder(engines)   # here too: a collider engine after us would run only after our step
     _guards.checkYadeContacts(scene, engines)
-    for engine in engines:
-        if isinstance(engine, wrapper.NewtonIntegrator):
-            for bodyId in list(scene.bodyOfBlock) + list(scene.clumpMembers):   # concave blocks' clumps too
-                body = O.bodies[bodyId]
-                if body is not None and body.dynamic and (engine.mask & body.groupMask):
-                    raise RuntimeError(
-                        'NewtonIntegrator would also move DDA block body %d (its groupMask %d overlaps '
-                        'NewtonIntegrator.mask %d). Give DDA blocks their own mask bit, e.g. '
-                        'ddaBlock(..., mask=2) and NewtonIntegrator(mask=1), so YADE moves only its own bodies.'
-                        % (bodyId, body.groupMask, engine.mask))
+    _guards.checkNewtonMask(scene, engines)
 
 
 def _takeUserDt(text):

@@ -12,6 +12,10 @@
 - Blocks entering the scene overlapping deeper than the initial-overlap
   tolerance (dda/solver/InitialOverlaps.hpp) are refused with the two body
   ids and the depth; nothing is added and no step is taken.
+- A ``NewtonIntegrator`` whose mask reaches a dynamic DDA block is refused:
+  beside ``DDAIntegrator`` it would move the block twice an iteration,
+  without one it would move it as a plain polyhedron (checked by the DDA
+  step, and by ``O.run``/``O.step`` when no DDAIntegrator is there).
 - Two DDA integrators in ``O.engines`` (each would advance the blocks once
   per iteration while ``O.time`` advances once) are refused.
 - A YADE ``InteractionLoop`` with a functor that handles ``Polyhedra`` (the
@@ -69,17 +73,52 @@ def markOverlapsChecked(scene):
 
 # ------------------------------------------------------------------ engines
 
-def _isIntegrator(engine):
+def isIntegrator(engine):
+    """A live DDAIntegrator (or the plain PyRunner of a loaded one)."""
     return (isinstance(engine, wrapper.PyRunner) and not engine.dead
             and engine.command.startswith(INTEGRATOR_COMMAND))
 
 
 def checkSingleIntegrator(engines):
-    positions = [k for k, engine in enumerate(engines) if _isIntegrator(engine)]
+    positions = [k for k, engine in enumerate(engines) if isIntegrator(engine)]
     if len(positions) > 1:
         raise RuntimeError('O.engines holds %d DDA integrators (at positions %s); each would advance the blocks '
                            'once per iteration while O.time advances once. Keep one.'
                            % (len(positions), ', '.join(map(str, positions))))
+
+
+def _ddaBodies(scene):
+    """Ids of the YADE bodies that move with DDA blocks: blocks and concave blocks' members in the core,
+    their clumps, and pending blocks already appended."""
+    ids = list(scene.bodyOfBlock) + list(scene.clumpMembers)
+    for body, spec in scene.pending:
+        ids.extend(member.id for member in getattr(spec, 'members', (body,)) if member.id >= 0)
+    return ids
+
+
+def checkNewtonMask(scene, engines):
+    """Refuses a live NewtonIntegrator whose mask reaches a dynamic DDA block: YADE would move it as a
+    plain polyhedron (beside DDAIntegrator, twice an iteration)."""
+    newtons = [e for e in engines if isinstance(e, wrapper.NewtonIntegrator) and not e.dead]
+    if not newtons:
+        return
+    integrated = any(isIntegrator(e) for e in engines)
+    for engine in newtons:
+        for bodyId in _ddaBodies(scene):
+            body = O.bodies[bodyId]
+            if body is not None and body.dynamic and (engine.mask & body.groupMask):
+                if integrated:
+                    raise RuntimeError(
+                        'NewtonIntegrator would also move DDA block body %d (its groupMask %d overlaps '
+                        'NewtonIntegrator.mask %d). Give DDA blocks their own mask bit, e.g. '
+                        'ddaBlock(..., mask=2) and NewtonIntegrator(mask=1), so YADE moves only its own bodies.'
+                        % (bodyId, body.groupMask, engine.mask))
+                raise RuntimeError(
+                    'NewtonIntegrator would move DDA block body %d as a plain polyhedron: no DDAIntegrator in '
+                    'O.engines moves the DDA blocks. Add DDAIntegrator(dt=..., gravity=...) (it replaces '
+                    'NewtonIntegrator, collider and contact laws for DDA blocks); for YADE bodies beside them keep '
+                    'NewtonIntegrator with a mask bit the blocks do not have, e.g. ddaBlock(..., mask=2) and '
+                    'NewtonIntegrator(mask=1). Nothing was run.' % bodyId)
 
 
 def checkColliderOrder(engines):

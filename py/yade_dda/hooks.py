@@ -9,12 +9,14 @@ import os
 import tempfile
 
 from ._yade import O, wrapper
+from . import guards as _guards
 from . import saveload as _saveload
 from . import scene as _scene
 from .params import finite
 
 _OMEGA_SAVES = ('save', 'saveTmp')
 _OMEGA_LOADS = ('load', 'loadTmp', 'reload')
+_OMEGA_RUNS = ('run', 'step')
 
 
 def _original(cls, name):
@@ -214,6 +216,21 @@ def _restoreScene(omega, path):
     _saveload.afterLoad(before)
 
 
+def _wrapRun(original):
+    """O.run and O.step: with a live NewtonIntegrator and no DDAIntegrator in O.engines (where no DDA step
+    would check the engines), refuse to let YADE move DDA blocks as plain polyhedra. A scene with a
+    DDAIntegrator is checked by its step; a scene without NewtonIntegrator costs one pass over O.engines."""
+    def run(self, *args, **kwargs):
+        engines = self.engines
+        if any(isinstance(e, wrapper.NewtonIntegrator) and not e.dead for e in engines) \
+                and not any(_guards.isIntegrator(e) for e in engines):
+            scene = _scene.current(create=False)
+            if scene is not None:
+                _guards.checkNewtonMask(scene, engines)
+        return original(self, *args, **kwargs)
+    return _wrapping(run, original)
+
+
 # ------------------------------------------------------------------ Omega.dt
 
 USER_DT_TAG = 'yade_dda.userDt'
@@ -335,6 +352,9 @@ def installHooks():
       the integrator's next step makes it ``DDAIntegrator.dt``, its largest
       step (engines.integratorStep). The integrator's own writes go through
       YADE's setter (writeDt).
+    - ``Omega.run`` and ``step``: a live NewtonIntegrator that would move DDA
+      blocks while no DDAIntegrator is in O.engines is refused before YADE
+      runs (guards.checkNewtonMask; with a DDAIntegrator its step checks).
     - ``utils.unbalancedForce`` (in yade.utils, yade._utils and the running
       script's namespace): DDA blocks count with the DDA step's gravity,
       which YADE would take from a NewtonIntegrator (unbalancedForce above).
@@ -345,7 +365,8 @@ def installHooks():
                              (wrapper.InteractionContainer, ('erase',), _wrapInteractionErase),
                              (wrapper.InteractionContainer, ('clear',), _wrapInteractionClear),
                              (wrapper.Omega, _OMEGA_SAVES, _wrapSave),
-                             (wrapper.Omega, _OMEGA_LOADS, _wrapLoad)):
+                             (wrapper.Omega, _OMEGA_LOADS, _wrapLoad),
+                             (wrapper.Omega, _OMEGA_RUNS, _wrapRun)):
         for name in names:
             setattr(cls, name, wrap(_original(cls, name)))
     wrapper.Omega.dt = _wrapDt(_yadeDt())

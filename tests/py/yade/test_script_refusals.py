@@ -288,3 +288,24 @@ def test_progress_is_off_in_batch_runs_and_when_asked(scene, capsys):
     assert _progressLines(capsys, 20) == []
     O.reset()
     assert _progressLines(capsys, 20, progressPeriod=0) == []
+
+
+@pytest.mark.parametrize('how', ['run', 'step'])
+def test_newton_without_dda_integrator_is_refused(how):
+    """A NewtonIntegrator with no DDAIntegrator would move DDA blocks as plain polyhedra (the block fell
+    under YADE's gravity): refused before YADE runs, nothing moved; with a mask bit the blocks do not
+    have, YADE's own bodies run as before."""
+    O.reset()
+    rock = material(O)
+    block = O.bodies.append(yade_dda.ddaBlock(box((0, 0, 1), (1, 1, 2)), material=rock, mask=2))
+    O.engines = [wrapper.ForceResetter(), wrapper.InsertionSortCollider([wrapper.Bo1_Polyhedra_Aabb()]),
+                 wrapper.NewtonIntegrator(gravity=(0, 0, -9.81))]
+    O.dt = 1e-3
+    with pytest.raises(RuntimeError, match='NewtonIntegrator would move DDA block body %d as a plain polyhedron'
+                       % block):
+        O.run(10, True) if how == 'run' else O.step()
+    assert O.iter == 0 and O.bodies[block].state.pos[2] == 1.5
+    O.engines[-1].mask = 1   # YADE's bodies only
+    O.run(10, True) if how == 'run' else O.step()
+    assert O.iter > 0 and O.bodies[block].state.pos[2] == 1.5
+    O.reset()
