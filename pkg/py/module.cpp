@@ -174,7 +174,8 @@ py::list unsettledBlocks(const SceneLink& s) {
 
 // The narrow phase of one pair of blocks at their current geometry, as the
 // integrator would see it with contact distance d0 [m]: None when farther
-// apart, else (structural type, entrance normal, [(kind, i owns, feature of
+// apart, else (structural type, entrance normal, the pair's separation, the
+// entrance axis's separation, [(kind, i owns, feature of
 // i, feature of j, gap, normal, point i, point j), ...]) with i, j block
 // indices of the sub-contact.
 py::object detectPair(const SceneLink& s, int a, int b, double d0) {
@@ -193,7 +194,8 @@ py::object detectPair(const SceneLink& s, int a, int b, double d0) {
 		subs.append(py::make_tuple(c.kind == ContactKind::VertexFace ? "VF" : "EE", c.firstIsA ? a : b,
 		                           c.firstIsA ? b : a, c.feature1, c.feature2, c.gap, c.normal, c.pointI, c.pointJ));
 	}
-	return py::make_tuple(contactTypeName(result->type), result->normal, result->separation, subs);
+	return py::make_tuple(contactTypeName(result->type), result->normal, result->pairSeparation,
+	                      result->separation, subs);
 }
 
 // Blocks overlapping when they enter the scene (dda/solver/InitialOverlaps.hpp):

@@ -531,7 +531,13 @@ class Ig2_DDABlock_DDABlock_DDAContact:
     farther apart than the contact distance, else a dict: ``type`` (structural
     type of Wu et al.'s Table 1: 'VV', 'VE', 'VF', 'EE', 'EEp', 'EF', 'FF'),
     ``normal`` (entrance normal, unit, from body1 towards body2),
-    ``separation`` [m] (along it; < 0 overlapping) and ``contacts``: the
+    ``separation`` [m] (the largest over the separating axes tested, face
+    normals and crossing edges: > 0 apart, a lower bound of the distance that
+    equals it unless the closest features are corners or a corner and an
+    edge; <= 0 overlapping or touching, minus the penetration depth),
+    ``entranceSeparation`` [m] (along the entrance normal; the entrance rules
+    prefer faces, so it may be negative for blocks that are apart, a corner
+    beside an edge) and ``contacts``: the
     vertex-face ('VF', the Ig2_Vertex_Face sub-functor) and edge-edge ('EE',
     Ig2_Edge_Edge) sub-contacts, each a dict with ``kind``, ``id1``/``id2``
     (id1 owns the vertex or first edge), ``feature1``/``feature2`` (vertex,
@@ -555,9 +561,9 @@ class Ig2_DDABlock_DDABlock_DDAContact:
         result = scene.core.detectPair(i, j, contactDistance)
         if result is None:
             return None
-        ctype, normal, separation, subs = result
+        ctype, normal, separation, entranceSeparation, subs = result
         bodyOf = scene.bodyOfBlock
-        return dict(type=ctype, normal=normal, separation=separation,
+        return dict(type=ctype, normal=normal, separation=separation, entranceSeparation=entranceSeparation,
                     contacts=[dict(kind=kind, id1=bodyOf[bi], id2=bodyOf[bj], feature1=f1, feature2=f2, gap=gap,
                                    normal=n, point1=p1, point2=p2)
                               for kind, bi, bj, f1, f2, gap, n, p1, p2 in subs])

@@ -128,6 +128,7 @@ bool detectPairContacts(const BlockGeometry& blockA, const BlockGeometry& blockB
 		return detectPairContacts(blockA, blockB, settings, out, EntranceFeature{}, linked, work);
 	out.entrance = entrance.feature;
 	out.separation = entrance.separation;
+	out.pairSeparation = std::max(axes.deepestBound, axes.nearParallelBest);
 
 	// 4. Structural type from the contact points of the sub-contacts
 	// (StructuralType.hpp).

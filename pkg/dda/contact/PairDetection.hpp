@@ -282,6 +282,13 @@ struct PairContacts {
 	ContactType type = ContactType::VertexFace;
 	EntranceFeature entrance;
 	double separation = 0;              // of the entrance axis [m], <= d0
+	// The largest separation over every axis tested (face normals, crossing
+	// edge pairs, near-parallel ones too) [m]: > 0 when the blocks are apart
+	// (a lower bound of their distance), else minus their penetration depth
+	// or less. The entrance may lie deeper (its rules prefer faces, and a
+	// corner by an edge takes a face), so only this one tells apart from
+	// overlapping.
+	double pairSeparation = 0;
 	Vector3 normal = Vector3::UnitZ();  // entrance normal, unit, from A towards B
 	std::vector<SubContact> contacts;   // may be empty (e.g. corners hanging past a face)
 };
