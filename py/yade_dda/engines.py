@@ -183,7 +183,20 @@ def _takeUserDt(text):
 
 
 def integratorStep(text):
-    """One DDA step; called by DDAIntegrator's command every iteration with its parameters."""
+    """One DDA step; called by DDAIntegrator's command every iteration with its parameters.
+
+    An exception is raised on to YADE with its traceback cut to this line
+    (YADE prints it in its "PyRunner error" report, twice) and kept whole for
+    the wrapped ``O.run``, ``O.step`` and ``O.wait``, which raise it again in
+    place of YADE's RuntimeError (guards.raiseStepError)."""
+    try:
+        _step(text)
+    except Exception as error:
+        _guards.STEP_ERROR[:] = [error, error.__traceback__]
+        raise error.with_traceback(None) from None
+
+
+def _step(text):
     start = time.perf_counter()
     if tag(USER_DT_TAG):
         text = _takeUserDt(text)

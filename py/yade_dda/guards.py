@@ -71,6 +71,24 @@ def markOverlapsChecked(scene):
     scene.overlapsChecked = scene.core.blockCount()
 
 
+# ------------------------------------------------------------------ a step's error
+
+STEP_ERROR = []
+"""[exception, its traceback] of the last DDA step that raised (engines.integratorStep), until O.run raises it."""
+
+
+def raiseStepError(error):
+    """Raises, in place of YADE's RuntimeError 'PyRunner error' `error` that reports a failed DDA step, the
+    exception that step raised (its type, message and traceback); returns when `error` is another one."""
+    text = str(error)
+    if len(STEP_ERROR) != 2 or not text.startswith('PyRunner error') or INTEGRATOR_COMMAND not in text:
+        return
+    stepError, traceback = STEP_ERROR
+    del STEP_ERROR[:]
+    if str(stepError) in text:
+        raise stepError.with_traceback(traceback) from None
+
+
 # ------------------------------------------------------------------ engines
 
 def isIntegrator(engine):

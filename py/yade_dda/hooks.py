@@ -16,7 +16,7 @@ from .params import finite
 
 _OMEGA_SAVES = ('save', 'saveTmp')
 _OMEGA_LOADS = ('load', 'loadTmp', 'reload')
-_OMEGA_RUNS = ('run', 'step')
+_OMEGA_RUNS = ('run', 'step', 'wait')
 
 
 def _original(cls, name):
@@ -217,17 +217,29 @@ def _restoreScene(omega, path):
 
 
 def _wrapRun(original):
-    """O.run and O.step: with a live NewtonIntegrator and no DDAIntegrator in O.engines (where no DDA step
-    would check the engines), refuse to let YADE move DDA blocks as plain polyhedra. A scene with a
-    DDAIntegrator is checked by its step; a scene without NewtonIntegrator costs one pass over O.engines."""
+    """O.run, O.step and O.wait.
+
+    - Before O.run and O.step: with a live NewtonIntegrator and no DDAIntegrator in O.engines (where no
+      DDA step would check the engines), refuse to let YADE move DDA blocks as plain polyhedra. A scene
+      with a DDAIntegrator is checked by its step; one without NewtonIntegrator costs a pass over O.engines.
+    - A DDA step that raised: YADE reports it as RuntimeError('PyRunner error. COMMAND ... ERROR ...
+      STACK TRACE ...'); the exception the step raised is raised instead (guards.raiseStepError), so a
+      script catches a ValueError as a ValueError."""
+    checks = original.__name__ in ('run', 'step')
+
     def run(self, *args, **kwargs):
-        engines = self.engines
-        if any(isinstance(e, wrapper.NewtonIntegrator) and not e.dead for e in engines) \
-                and not any(_guards.isIntegrator(e) for e in engines):
-            scene = _scene.current(create=False)
-            if scene is not None:
-                _guards.checkNewtonMask(scene, engines)
-        return original(self, *args, **kwargs)
+        if checks:
+            engines = self.engines
+            if any(isinstance(e, wrapper.NewtonIntegrator) and not e.dead for e in engines) \
+                    and not any(_guards.isIntegrator(e) for e in engines):
+                scene = _scene.current(create=False)
+                if scene is not None:
+                    _guards.checkNewtonMask(scene, engines)
+        try:
+            return original(self, *args, **kwargs)
+        except RuntimeError as error:
+            _guards.raiseStepError(error)
+            raise
     return _wrapping(run, original)
 
 

@@ -221,7 +221,7 @@ def test_bad_parts_are_refused_naming_the_problem(scene):
     # Members appended one by one, not as a clump: refused at the first step, naming appendClumped.
     O.bodies.append(concaveBlock(l_parts(), material=rock))
     O.engines = [DDAIntegrator(dt=1e-3)]
-    with pytest.raises(RuntimeError, match='appendClumped'):   # YADE's PyRunner re-raises it as RuntimeError
+    with pytest.raises(ValueError, match='appendClumped'):   # the step's own exception, not YADE's RuntimeError
         O.step()
 
 

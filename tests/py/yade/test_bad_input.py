@@ -405,7 +405,7 @@ def test_dda_block_added_mid_run_into_another_is_refused(scene):
     floor, free = running()
     O.bodies.append(ddaBlock(box((0.5, 0, 2), (1.5, 1, 3))))
     before = snapshot()
-    with pytest.raises(RuntimeError, match=r'DDA blocks body 1 and body 2 overlap by 0.5 m as they enter the scene'):
+    with pytest.raises(ValueError, match=r'DDA blocks body 1 and body 2 overlap by 0.5 m as they enter the scene'):
         O.step()
     assert snapshot() == before
     assert yade_dda.scene.current().core.blockCount() == 2   # nothing was added to the core
@@ -419,7 +419,7 @@ def test_initial_overlap_is_refused_with_bodies_and_depth(scene):
     free = O.bodies.append(ddaBlock(box((0, 0, -0.0076), (1, 1, 0.9924)), material=mat))
     O.engines = [DDAIntegrator(dt=1e-3, gravity=(0, 0, -G))]
     before = snapshot()
-    with pytest.raises(RuntimeError, match=r'DDA blocks body %d and body %d overlap by 0.0076 m as they enter the '
+    with pytest.raises(ValueError, match=r'DDA blocks body %d and body %d overlap by 0.0076 m as they enter the '
                                            r'scene, more than the 2.924e-06 m accepted' % (floor, free)):
         O.step()
     assert snapshot() == before and yade_dda.scene.current().core.blockCount() == 0

@@ -309,3 +309,53 @@ def test_newton_without_dda_integrator_is_refused(how):
     O.run(10, True) if how == 'run' else O.step()
     assert O.iter > 0 and O.bodies[block].state.pos[2] == 1.5
     O.reset()
+
+
+OVERLAPPING_SCRIPT = '''
+from yade_dda import *
+O.bodies.append(ddaBlock([(x, y, z) for x in (0, 1) for y in (0, 1) for z in (0, 1)]))
+O.bodies.append(ddaBlock([(x, y, z) for x in (0.5, 1.5) for y in (0, 1) for z in (0, 1)]))
+O.engines = [DDAIntegrator(dt=1e-3, gravity=(0, 0, -9.81))]
+O.run(3, True)
+'''
+
+
+@pytest.mark.parametrize('how', ['run', 'step', 'background'])
+def test_a_steps_error_is_raised_as_itself(how):
+    """A DDA step that raises (blocks entering 0.5 m deep into each other): O.run, O.step and O.wait
+    raise that ValueError, not YADE's RuntimeError('PyRunner error ...') that quotes it, so a script
+    catches it by its type; the scene is unchanged and runs on once the cause is gone."""
+    O.reset()
+    O.bodies.append(yade_dda.ddaBlock(box((0, 0, 0), (1, 1, 1))))
+    extra = O.bodies.append(yade_dda.ddaBlock(box((0.5, 0, 0), (1.5, 1, 1))))
+    O.engines = [yade_dda.DDAIntegrator(dt=1e-3)]
+    with pytest.raises(ValueError, match=r'DDA blocks body 0 and body 1 overlap by 0.5 m'):
+        if how == 'run':
+            O.run(3, True)
+        elif how == 'step':
+            O.step()
+        else:
+            O.run(3)
+            O.wait()
+    assert O.iter == 0
+    O.bodies.erase(extra)
+    O.run(3, True)
+    assert O.iter == 3
+    O.reset()
+
+
+def test_a_steps_error_in_a_script_ends_with_the_error(tmp_path):
+    """Run by yade -x: the report ends with the step's own ValueError (YADE's report of the failed
+    engine stays before it); it was 76 lines with the message six times, quoted inside 'PyRunner error'."""
+    import subprocess
+    script = tmp_path / 'overlap.py'
+    script.write_text(OVERLAPPING_SCRIPT)
+    env = dict(os.environ, PYTHONPATH=os.path.dirname(os.path.dirname(yade_dda.__file__)) + os.pathsep
+               + os.environ.get('PYTHONPATH', ''))
+    result = subprocess.run(['yade', '-n', '-x', str(script)], capture_output=True, text=True, timeout=120,
+                            env=env, stdin=subprocess.DEVNULL)
+    lines = [l for l in (result.stdout + result.stderr).splitlines() if l.strip()]
+    assert result.returncode != 0
+    assert lines[-1].startswith('ValueError: DDA blocks body 0 and body 1 overlap by 0.5 m'), lines[-5:]
+    mentions = sum('overlap by 0.5 m' in l for l in lines)
+    assert mentions <= 4 and len(lines) <= 50, (mentions, len(lines))

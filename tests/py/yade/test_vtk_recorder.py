@@ -241,7 +241,7 @@ def test_the_series_continues_after_save_and_load(scene, tmp_path):
     displacement = _array(_read(uninterrupted[-1][1]), 'displacement')
     O.load(saved)
     engine = O.engines[-1]
-    assert type(engine).__name__ == 'PyRunner' and engine.command == recorder.command(prefix)
+    assert type(engine) is recorder.DDAVTKRecorder and engine.command == recorder.command(prefix)
     assert engine.iterPeriod == 10
     O.run(20, True)
     series = recorder.readSeries(prefix + 'blocks.pvd')
