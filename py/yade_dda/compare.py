@@ -19,7 +19,7 @@ from ._yade import O, utils, wrapper
 from . import colliders as _colliders
 from . import params as _settings
 from .params import finite
-from .blocks import ddaBlock
+from .blocks import concaveBlock, ddaBlock
 from .engines import DDAIntegrator
 from . import scene as _scene
 from .scene import stats as _stats
@@ -31,22 +31,43 @@ DEFAULT_OUT = os.path.join('bench', 'out', 'compare_colliders.json')
 _POLYHEDRA_LOGGER = 'Polyhedra_support.cpp'   # YADE's logger of its polyhedron intersection
 
 
+def _isPoint(p):
+    try:
+        return len(p) == 3 and all(isinstance(float(x), float) for x in p)
+    except (TypeError, ValueError):
+        return False
+
+
+def _parts(shape, i):
+    """[points] of a convex block (a list of points) or [[points], ...] of a concave one (a list of convex
+    parts, each a list of points), as float tuples."""
+    shape = list(shape)
+    nested = bool(shape) and not _isPoint(shape[0])
+    try:
+        parts = [list(part) for part in shape] if nested else [shape]
+        return [[tuple(float(x) for x in p) for p in part] for part in parts]
+    except (TypeError, ValueError):
+        raise TypeError('block %d: expected a list of points (a convex block) or of convex parts (a concave '
+                        'block), each point 3 numbers, got %r' % (i, shape)) from None
+
+
 def _blockList(blocks):
-    """[(points, fixed)] from a list of (vertices, fixed) or bare vertex lists, or a builder returning one."""
+    """[(parts, fixed)] from a list of (shape, fixed) or bare shapes, a shape being the vertex list of a
+    convex block or the list of convex parts of a concave one; or a builder returning such a list; or a
+    RockMass of cutRockMass (its groups, all free)."""
     if callable(blocks):
         blocks = blocks()
+    if hasattr(blocks, 'groups') and hasattr(blocks, 'blocks'):   # a RockMass
+        blocks = [[blocks.blocks[k].corners for k in group] for group in blocks.groups]
     out = []
     for i, entry in enumerate(blocks):
         entry = list(entry)
-        if len(entry) == 2 and isinstance(entry[1], (bool, int)) and not isinstance(entry[0], (int, float)):
-            points, fixed = entry[0], bool(entry[1])
+        if len(entry) == 2 and isinstance(entry[1], (bool, int)) and not isinstance(entry[0], (int, float)) \
+                and not _isPoint(entry[0]):
+            shape, fixed = entry[0], bool(entry[1])
         else:
-            points, fixed = entry, False
-        try:
-            points = [tuple(float(x) for x in p) for p in points]
-        except TypeError:
-            raise TypeError('block %d: expected (vertices, fixed) or a list of points, got %r' % (i, entry)) from None
-        out.append((points, fixed))
+            shape, fixed = entry, False
+        out.append((_parts(shape, i), fixed))
     if len(out) < 2:
         raise ValueError('compareColliders needs at least 2 blocks, got %d' % len(out))
     return out
@@ -76,8 +97,11 @@ def _summary(name, kind, perStep):
 def _runOurs(name, blockList, steps, dt, gravity, mat, threads, integrator):
     O.reset()
     material = _material(**mat)
-    for points, fixed in blockList:
-        O.bodies.append(ddaBlock(points, material=material, fixed=fixed))
+    for parts, fixed in blockList:
+        if len(parts) == 1:
+            O.bodies.append(ddaBlock(parts[0], material=material, fixed=fixed))
+        else:
+            O.bodies.appendClumped(concaveBlock(parts, material=material, fixed=fixed))
     params = dict(integrator)
     # Every strategy searches every step (DESS's candidate-pair cache, an effect on demand, is off).
     params.update(dt=dt, gravity=tuple(gravity), threads=threads, reuseCandidatePairs=False)
@@ -112,8 +136,14 @@ def _runOurs(name, blockList, steps, dt, gravity, mat, threads, integrator):
 def _runYade(name, blockList, steps, dt, gravity, mat, threads, verletDist, damping):
     O.reset()
     material = _material(**mat)
-    for points, fixed in blockList:
-        O.bodies.append(utils.polyhedron(points, fixed=fixed, material=material))
+    for parts, fixed in blockList:
+        if len(parts) == 1:
+            O.bodies.append(utils.polyhedron(parts[0], fixed=fixed, material=material))
+        else:   # a concave block: a YADE clump of its convex parts
+            clump, _ = O.bodies.appendClumped([utils.polyhedron(part, fixed=fixed, material=material)
+                                               for part in parts])
+            if fixed:
+                O.bodies[clump].dynamic = False
     bound = wrapper.Bo1_Polyhedra_Aabb()
     if name == 'InsertionSortCollider':
         collider = wrapper.InsertionSortCollider([bound], verletDist=verletDist, label='collider')
@@ -268,8 +298,12 @@ def compareColliders(blocks, steps=100, dt=1e-3, gravity=(0, 0, -9.81), strategi
 
     The scene in ``O`` is replaced (``O.reset()`` before each run).
 
-    :param blocks: list of ``(vertices, fixed)`` (or bare vertex lists, free
-        blocks), vertices in m; or a callable returning such a list.
+    :param blocks: list of ``(shape, fixed)`` (or bare shapes, free blocks),
+        a shape being the vertex list of a convex block or the list of convex
+        parts of a concave one (each a vertex list; ``concaveBlock`` for DDA,
+        a clump of ``Polyhedra`` for YADE), vertices in m; or a callable
+        returning such a list; or a ``cutRockMass`` result (its blocks as
+        grouped, all free).
     :param steps: steps per run.
     :param dt: time step [s] for both: DDA's largest step (DDA may cut it;
         ``perStep[...]['dt']``), YADE's fixed ``O.dt``.
@@ -332,8 +366,13 @@ def compareColliders(blocks, steps=100, dt=1e-3, gravity=(0, 0, -9.81), strategi
         perStep[name], positions[name], told[name] = _runOurs(name, blockList, steps, dt, gravity, mat, threads,
                                                               integrator)
         rows.append(_summary(name, 'dda', perStep[name]))
+    if yade and any(len(parts) > 1 for parts, _ in blockList):
+        # YADE 2023.02a's SpatialQuickSortCollider takes a clump (it has no bound) for a body it can test
+        # and crashes in Collider::mayCollide (a segfault, found by gdb on an L-shaped clump of polyhedra).
+        skipped['SpatialQuickSortCollider'] = ('crashes on clumps in this YADE (segfault in Collider::mayCollide); '
+                                               'not run on scenes with concave blocks')
     if yade:
-        for name in YADE_COLLIDERS:
+        for name in (n for n in YADE_COLLIDERS if n not in skipped):
             perStep[name], positions[name], told[name] = _runYade(name, blockList, steps, dt, gravity, mat, threads,
                                                                   verletDist, damping)
             rows.append(_summary(name, 'yade', perStep[name]))
