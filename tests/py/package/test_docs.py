@@ -1,7 +1,8 @@
 """The documentation pages hold together and fit their reader.
 
-README.md stays a front page (at most 250 lines; the manual is doc/user-guide.md),
-and every relative link in README.md and doc/*.md, text or image, points to a
+README.md stays a front page (at most 250 lines; the manual is the guide in
+doc/guide/, indexed by doc/user-guide.md), and every relative link in README.md,
+doc/*.md and doc/guide/*.md, text or image, points to a
 file that exists; a link's #anchor into a Markdown page (or within one) names a
 heading of that page, by GitHub's rule for heading ids. Links to http(s) and
 mailto addresses are not followed. Pure Python: no YADE scene is used.
@@ -27,7 +28,8 @@ def _repository():
 REPO = _repository()
 README_MAX_LINES = 250
 
-PAGES = ['README.md'] + sorted(os.path.relpath(p, REPO) for p in glob.glob(os.path.join(REPO, 'doc', '*.md')))
+PAGES = ['README.md'] + sorted(os.path.relpath(p, REPO) for pattern in (('doc', '*.md'), ('doc', 'guide', '*.md'))
+                               for p in glob.glob(os.path.join(REPO, *pattern)))
 
 # [text](target) and ![alt](target), with an optional "title"; text may hold
 # one level of brackets (an image inside a link).
@@ -100,12 +102,14 @@ def test_readme_is_a_front_page():
     if lines and lines[-1] == '':
         lines.pop()
     assert len(lines) <= README_MAX_LINES, (
-        'README.md has %d lines, more than %d: move detail into doc/ (user-guide.md, benchmarks.md, testing.md)'
+        'README.md has %d lines, more than %d: move detail into doc/ (guide/, benchmarks.md, testing.md)'
         % (len(lines), README_MAX_LINES))
 
 
 def test_pages_are_found():
     assert 'README.md' in PAGES and os.path.join('doc', 'user-guide.md') in PAGES, PAGES
+    for part in ('tutorial', 'how-to', 'reference', 'explanation'):
+        assert os.path.join('doc', 'guide', part + '.md') in PAGES, PAGES
 
 
 @pytest.mark.parametrize('page', PAGES)
