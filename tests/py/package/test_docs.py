@@ -1,6 +1,6 @@
 """The documentation pages hold together and fit their reader.
 
-README.md stays a front page (at most 250 lines; the manual is the guide in
+README.md stays a front page (at most 200 lines; the manual is the guide in
 doc/guide/, indexed by doc/user-guide.md), and every relative link in README.md,
 doc/*.md and doc/guide/*.md, text or image, points to a
 file that exists; a link's #anchor into a Markdown page (or within one) names a
@@ -26,7 +26,7 @@ def _repository():
 
 
 REPO = _repository()
-README_MAX_LINES = 250
+README_MAX_LINES = 200
 
 PAGES = ['README.md'] + sorted(os.path.relpath(p, REPO) for pattern in (('doc', '*.md'), ('doc', 'guide', '*.md'))
                                for p in glob.glob(os.path.join(REPO, *pattern)))
