@@ -75,7 +75,7 @@ docs: build
 fingerprints: install
 	$(PYTHON) bench/fingerprints.py
 
-# Batch regressions (doc/user-guide.md, "Batch regressions"): yade-batch runs every row of a table in
+# Batch regressions (doc/guide/how-to.md, "Batch regressions"): yade-batch runs every row of a table in
 # examples/regression, each scene writes a record, check.py compares them with closed forms and
 # stored references and exits non-zero on any failure. Logs and records go to $(REGRESS_OUT)/<table>.
 REGRESS_OUT := $(BUILD)/regress
@@ -97,7 +97,7 @@ regress-run:
 	    --log "$$out/@.log" $(TABLE).table 2>&1) | tee $$out/yade-batch.log | grep --line-buffered -E '^#[0-9]+ \('; true
 	$(PYTHON) examples/regression/check.py examples/regression/$(TABLE).table $(abspath $(REGRESS_OUT))/$(TABLE) $(CHECK_ARGS)
 
-# Sweeps on a cluster (doc/user-guide.md, "Sweeps on a cluster"): every row of a yade-batch table as its own
+# Sweeps on a cluster (doc/guide/how-to.md, "Sweeps on a cluster"): every row of a yade-batch table as its own
 # YADE process on Dask distributed (python3 -m yade_dda.sweep), with the build tree's yade_dda; a local
 # cluster of JOBS single-threaded workers unless SWEEP_ARGS says otherwise (--scheduler tcp://HOST:8786,
 # --workers N, --timeout S). TABLE is a path or the name of a table in examples/regression (default quick).

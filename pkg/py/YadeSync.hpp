@@ -22,7 +22,7 @@
 // it believes nonzero) checks that nobody reset or changed them since. On a
 // mismatch (a ForceResetter ran, O.forces.reset(), permanent forces) every
 // block's force is read back and the difference added, as the Python sync
-// did. See doc/user-guide.md, "What YADE sees".
+// did. See doc/guide/explanation.md, "What YADE sees".
 #pragma once
 
 #include "SceneLink.hpp"

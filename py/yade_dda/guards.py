@@ -1,4 +1,4 @@
-"""Checks that keep a DDA scene in a state the core can simulate (doc/user-guide.md, "Bad input").
+"""Checks that keep a DDA scene in a state the core can simulate (doc/guide/reference.md, "Bad input").
 
 - ``O.bodies.erase(id)`` of a DDA block that has entered the core (after the
   first step) raises and erases nothing: the core cannot remove a block from
@@ -63,7 +63,7 @@ def checkInitialOverlaps(scene, settings):
         raise ValueError(
             'DDA blocks body %d and body %d overlap by %.4g m as they enter the scene, more than the %.4g m '
             'accepted%s: their contact springs would push them apart with a spurious energy. Move them apart; the '
-            'tolerance is min(d0, max(2 W / kn, 1e-6 x block size)) (doc/user-guide.md, "Bad input"). Nothing was added and '
+            'tolerance is min(d0, max(2 W / kn, 1e-6 x block size)) (doc/guide/reference.md, "Bad input"). Nothing was added and '
             'no step was taken.' % (bodyOf(a), bodyOf(b), depth, tolerance, more))
 
 

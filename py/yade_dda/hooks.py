@@ -343,7 +343,7 @@ def installHooks():
 
     - ``BodyContainer.erase`` (``O.bodies.erase``): refuses to erase a DDA
       block that has entered the core (the core cannot remove blocks from a
-      running scene yet) and forgets a pending one (doc/user-guide.md, "Bad input").
+      running scene yet) and forgets a pending one (doc/guide/reference.md, "Bad input").
     - ``BodyContainer.clear`` and ``replace``: give the YADE scene a fresh,
       empty DDA scene that keeps the pending blocks among the new bodies and
       those made by ``ddaBlock()`` but not yet appended (scene.freshScene).

@@ -112,7 +112,7 @@ class DDAVTKRecorder(Engine, wrapper.PyRunner):
     double precision) and a ``.vtp`` of the contacts (a point per
     sub-contact), and the time series ``PREFIX + 'blocks.pvd'`` and ``PREFIX +
     'contacts.pvd'`` with the simulated time of each output (module
-    docstring; doc/user-guide.md, "ParaView output: DDAVTKRecorder").
+    docstring; doc/guide/how-to.md, "ParaView output: DDAVTKRecorder").
 
     Parameters: ``fileName`` (path prefix, default 'vtk/dda-'; its directory
     is made when missing), and YADE's periods: ``iterPeriod`` [iterations],

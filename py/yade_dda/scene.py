@@ -334,8 +334,8 @@ def stats():
     point loads and fixed points); ``contactChanges`` is what the contacts'
     springs gained between steps (new penetrating contacts, gaps linearised
     again, springs lost when contacts vanish). kinetic + gravity + strain + contact +
-    friction + damping - loads - contactChanges is conserved (doc/user-guide.md,
-    "Diagnostics").
+    friction + damping - loads - contactChanges is conserved (doc/guide/reference.md,
+    "The energy account").
     ``memory``: heap bytes held after the detection: ``collider`` (the broad
     phase's arrays: boxes, shells, grid, caches), ``contacts`` (the contact
     store with the previous step's contacts kept for their history) and

@@ -10,7 +10,7 @@ the scene of each row, ``description`` the name of its record) runs as
 ``LocalCluster`` of N worker processes with one thread each (default), or on
 the workers of an existing scheduler (``--scheduler tcp://host:8786``, or the
 scheduler file of ``dask scheduler --scheduler-file``: a SLURM or Kubernetes
-cluster, doc/user-guide.md, "Sweeps on a cluster").
+cluster, doc/guide/how-to.md, "Sweeps on a cluster").
 
 The scene writes its record into a directory private to the task (the
 worker's local directory); the task sends the record and the scene's output
@@ -35,7 +35,7 @@ allows; each failure is reported with the path and the last lines of its
 log, and the command exits 1 (0 when every row passed). A row that exits
 normally is done, as yade-batch has it, with or without a record: a scene
 writes one only if it asks to (``yade_dda.regression.Record``, which writes
-``<description>.json`` into ``$YADE_DDA_RECORDS``; doc/user-guide.md, "Batch
+``<description>.json`` into ``$YADE_DDA_RECORDS``; doc/guide/how-to.md, "Batch
 regressions"). Rows done without one are named in the summary, and
 ``examples/regression/check.py`` fails a row whose record is missing.
 

@@ -1,5 +1,5 @@
 """What YADE sees of the DDA scene: interactions, forces and energy
-(doc/user-guide.md, "What YADE sees: interactions, forces, energy").
+(doc/guide/explanation.md, "What YADE sees: interactions, forces, energy").
 
 Written at every sync (scene.DDAScene.sync), so under the same policy as the
 bodies: only when something may read them.

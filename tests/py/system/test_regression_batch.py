@@ -1,4 +1,4 @@
-"""Batch regressions (doc/user-guide.md, "Batch regressions"): the quick table through yade-batch and check.py.
+"""Batch regressions (doc/guide/how-to.md, "Batch regressions"): the quick table through yade-batch and check.py.
 
 This is how CI runs the quick table. One yade-batch run (the fixture `batch` of
 tests/py/system/conftest.py, shared with test_sweep.py) of

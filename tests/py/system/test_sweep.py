@@ -1,4 +1,4 @@
-"""Sweeps on a cluster (doc/user-guide.md, "Sweeps on a cluster"): `python3 -m yade_dda.sweep` on Dask.
+"""Sweeps on a cluster (doc/guide/how-to.md, "Sweeps on a cluster"): `python3 -m yade_dda.sweep` on Dask.
 
 - The quick table (`python3 -m yade_dda.sweep examples/regression/quick.table
   --workers 2 --out DIR`, a local cluster) passes check.py; the records and

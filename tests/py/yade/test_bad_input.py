@@ -1,4 +1,4 @@
-"""Bad input, everywhere a user can type (doc/user-guide.md, "Bad input").
+"""Bad input, everywhere a user can type (doc/guide/reference.md, "Bad input").
 
 One test per case. Each asserts the exception and its message (which names
 the problem and the body or parameter) and that the scene is unchanged: the
