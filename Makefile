@@ -69,6 +69,7 @@ bench-pile200: install
 # tests/py/package/test_parameter_reference.py fails when it is stale.
 docs: build
 	YADE_DDA_BUILD=$(abspath $(BUILD))/py $(PYTHON) tools/gen_docs.py
+	YADE_DDA_BUILD=$(abspath $(BUILD))/py $(PYTHON) tools/gen_api.py
 
 # Step-by-step fingerprints of every regression and paper scene (bench/out/fingerprints.json), for a
 # refactor that must leave them bitwise: compare with bench/fingerprints.py --compare A B. About 2 minutes.
