@@ -30,7 +30,11 @@ from .saveload import Checkpoint, latestCheckpoint, writeCheckpoint, storeState,
 from .scene import (stats, sync, block, blockOf, setVelocity, addPointLoad, addFixedPoint,
                     printStats, contacts, Ig2_DDABlock_DDABlock_DDAContact)
 
+from . import saveload as _saveload
+from .typedengines import typedEngines as _typedEngines
+
 installHooks()
+_saveload.onLoad(_typedEngines)
 
 __all__ = ['ddaBlock', 'rigidBlock', 'concaveBlock', 'cutRockMass', 'DDAIntegrator', 'MSCCollider', 'DESSCollider', 'NBSCollider', 'AllPairsCollider',
            'Checkpoint', 'latestCheckpoint', 'DDAVTKRecorder', 'stats', 'printStats', 'sync', 'block', 'blockOf',

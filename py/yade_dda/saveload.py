@@ -65,15 +65,26 @@ def currentToken():
     return tag(_scene.TAG) or None
 
 
+_onLoad = []
+
+
+def onLoad(function):
+    """Runs function() after every load, before the DDA state is restored (the package registers
+    typedengines.typedEngines: the engine classes live in modules that import this one)."""
+    if function not in _onLoad:
+        _onLoad.append(function)
+
+
 def afterLoad(before):
     """What the wrapped loads do once YADE has read a scene: forget the core
     scenes of the replaced and of the loaded token (both are stale now), then
     rebuild the loaded scene's DDA state from its tag. A scene with DDA blocks
-    but no saved state loads with a warning; DDA calls then raise. The
+    but no saved state loads with a warning; DDA calls then raise. First
+    the functions given to onLoad run (the package gives typedEngines: the
     yade_dda engines, which YADE loads as plain PyRunners, get their classes
-    back (typedengines.typedEngines)."""
-    from .typedengines import typedEngines
-    typedEngines()
+    back)."""
+    for function in _onLoad:
+        function()
     loaded = currentToken()
     for token in (before, loaded):
         if token:

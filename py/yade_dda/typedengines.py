@@ -12,6 +12,7 @@ gravity as before the save; a command that is not ours is left alone.
 import ast
 
 from ._yade import O, wrapper
+from . import colliders, engines, recorder, saveload
 
 _BOOKKEEPING = ('dead', 'iterLast', 'virtLast', 'realLast', 'nDone')
 """YADE's PeriodicEngine attributes carried from the loaded engine to the rebuilt one."""
@@ -58,7 +59,6 @@ def _typed(engine):
 
 def _build(engine, command, name, args, kwargs):
     """A new engine of the class whose command `command` is (its call parsed: `name`, `args`, `kwargs`)."""
-    from . import colliders, engines, recorder, saveload
     if command.startswith('import yade_dda.engines ') and name == 'integratorStep' and len(args) == 1:
         return engines.DDAIntegrator(**ast.literal_eval(args[0]))
     if command.startswith(colliders.COLLIDER_COMMAND) and name == '_select' and len(args) == 1:
@@ -79,7 +79,8 @@ def _build(engine, command, name, args, kwargs):
 
 def typedEngines():
     """Replaces, in ``O.engines``, every plain PyRunner that runs a yade_dda engine's command by that engine
-    (called by the wrapped ``O.load``, ``loadTmp`` and ``reload``). Returns how many were replaced."""
+    (run by the wrapped ``O.load``, ``loadTmp`` and ``reload``: saveload.onLoad). Returns how many were
+    replaced."""
     current = list(O.engines)
     replaced = 0
     for k, engine in enumerate(current):

@@ -324,8 +324,9 @@ def _polygon_distance(x, pts):
 def rest_account(free):
     """stats()['energy'] of the placed scene before its first step (the account then
     reads 0 for gravity): every term 0 but gravity, -m g . c summed over the free
-    blocks (bodies `free`) [J]. Needs YADE; gravity (0, 0, -G)."""
+    blocks (bodies `free`) [J] (gravityChange, measured from the blocks' initial
+    centroids, is 0). Needs YADE; gravity (0, 0, -G)."""
     import yade_dda
     gravity = math.fsum(yade_dda.block(i).mass * G * yade_dda.block(i).centroid[2] for i in free)
-    return dict(kinetic=0.0, gravity=gravity, strain=0.0, contact=0.0, friction=0.0, damping=0.0, loads=0.0,
-                contactChanges=0.0)
+    return dict(kinetic=0.0, gravity=gravity, gravityChange=0.0, strain=0.0, contact=0.0, friction=0.0, damping=0.0,
+                loads=0.0, contactChanges=0.0)
