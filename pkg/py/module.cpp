@@ -234,29 +234,23 @@ void setCover(SceneLink& s, double criticalLength, int segments) {
 	s.world.collider().setCover(criticalLength, segments);
 }
 
+// One entry per row of Statistics.def (a sub-dict for a row's group), then
+// the energy account and the memory held, which have their own structs.
 py::dict lastStep(const SceneLink& s) {
 	const StepStatistics& st = s.world.lastStep();
-	py::dict d;
-	d["dt"] = st.dt;
-	d["stepCuts"] = st.stepCuts;
-	d["displacementLimitMisses"] = st.displacementLimitMisses;
-	d["maxDisplacement"] = st.maxDisplacement;
-	d["allowedDisplacement"] = st.allowedDisplacement;
-	d["blocks"] = st.blocks;
-	d["movingBlocks"] = st.movingBlocks;
-	d["unknowns"] = st.unknowns;
-	d["rigidBlocks"] = st.rigidBlocks;
-	d["strainUnknowns"] = st.strainUnknowns;
-	d["solvedUnknowns"] = st.solvedUnknowns;
-	d["contactDistance"] = st.contactDistance;
-	d["candidatePairs"] = st.candidatePairs;
-	d["shellPairs"] = st.shellPairs;
-	d["shellTests"] = st.shellTests;
-	d["shells"] = st.shells;
-	d["shellUpdates"] = st.shellUpdates;
-	d["subUnitPairs"] = st.subUnitPairs;
-	d["subUnitTests"] = st.subUnitTests;
-	d["fullSearchPairs"] = st.fullSearchPairs;
+	py::dict d, groups;
+	auto put = [&](const char* group, const char* key, const py::object& value) {
+		if (!*group) {
+			d[key] = value;
+			return;
+		}
+		if (!groups.has_key(group)) groups[group] = py::dict();
+		py::dict sub = py::extract<py::dict>(groups[group]);
+		sub[key] = value;
+	};
+#define DDA_STAT(type, name, group, key, unit, doc) put(group, #key, py::object(st.name));
+#include "dda/solver/Statistics.def"
+	d.update(groups);
 	const World::MemoryUse use = s.world.memoryUse();
 	py::dict memory;
 	memory["collider"] = use.collider;
@@ -276,57 +270,26 @@ py::dict lastStep(const SceneLink& s) {
 	energy["loads"] = account.loads;
 	energy["contactChanges"] = account.contactChanges;
 	d["energy"] = energy;
-	d["contactPairs"] = st.contactPairs;
-	d["contacts"] = st.contacts;
-	d["closedContacts"] = st.closedContacts;
-	d["slidingContacts"] = st.slidingContacts;
-	d["openCloseIterations"] = st.openCloseIterations;
-	d["openCloseIterationsTotal"] = st.openCloseIterationsTotal;
-	d["stateChanges"] = st.stateChanges;
-	d["normalForceUpdates"] = st.normalForceUpdates;
-	d["lineSearches"] = st.lineSearches;
-	d["refinedComponents"] = st.refinedComponents;
-	d["refineIterations"] = st.refineIterations;
-	d["refineFallbacks"] = st.refineFallbacks;
-	d["iterativeComponents"] = st.iterativeComponents;
-	d["iterativeIterations"] = st.iterativeIterations;
-	d["iterativeFallbacks"] = st.iterativeFallbacks;
-	d["limitPasses"] = st.limitPasses;
-	d["limitsLowered"] = st.limitsLowered;
-	d["limitsUnsettled"] = st.limitsUnsettled;
-	d["settleSteps"] = st.settleSteps;
-	d["settledBlocks"] = st.settledBlocks;
-	d["settleConverged"] = st.settleConverged;
-	d["openCloseCuts"] = st.openCloseCuts;
-	d["openCloseFailures"] = st.openCloseFailures;
-	d["maxPenetration"] = st.maxPenetration;
-	d["components"] = st.components;
-	d["largestComponent"] = st.largestComponent;
-	d["systemStructures"] = st.systemStructures;
-	d["broadPhaseSkipped"] = st.broadPhaseSkipped;
-	d["pairsReused"] = st.pairsReused;
-	d["blocksResearched"] = st.blocksResearched;
-	d["fixedPairsSearched"] = st.fixedPairsSearched;
-	d["frictionTerms"] = st.frictionTerms;
-	d["normalTerms"] = st.normalTerms;
-	d["bodyForceBlocks"] = st.bodyForceBlocks;
-	d["frictionContacts"] = st.frictionContacts;
-	d["bondedContacts"] = st.bondedContacts;
-	d["fixedBlocks"] = st.fixedBlocks;
-	d["staticAnalysis"] = st.staticAnalysis;
-	py::dict times;
-	times["broadPhase"] = st.timeBroadPhase;
-	times["narrowPhase"] = st.timeNarrowPhase;
-	times["assembly"] = st.timeAssembly;
-	times["solve"] = st.timeSolve;
-	times["update"] = st.timeUpdate;
-	times["core"] = st.timeTotal;
-	d["time"] = times;
-	py::dict cpu;
-	cpu["broadPhase"] = st.cpuBroadPhase;
-	cpu["narrowPhase"] = st.cpuNarrowPhase;
-	d["cpuTime"] = cpu;
 	return d;
+}
+
+// _core.statisticsTable(): one dict per row of Statistics.def, in its order
+// (group, key, kind, unit, doc), from which yade_dda.stats()'s docstring
+// lists the step's report.
+py::tuple statisticsTable() {
+	py::list rows;
+	auto row = [&](const char* group, const char* key, const char* kind, const char* unit, const char* doc) {
+		py::dict r;
+		r["group"] = group;
+		r["key"] = key;
+		r["kind"] = kind;
+		r["unit"] = unit;
+		r["doc"] = doc;
+		rows.append(r);
+	};
+#define DDA_STAT(type, name, group, key, unit, doc) row(group, #key, #type, unit, doc);
+#include "dda/solver/Statistics.def"
+	return py::tuple(rows);
 }
 
 // _core.settingsTable(): one dict per row of Settings.def, in its order, from
@@ -574,6 +537,9 @@ BOOST_PYTHON_MODULE(_core) {
 
 	py::scope().attr("mscMaxSegments") = kMaxCoverSegments;
 
+	py::def("statisticsTable", &statisticsTable,
+	        "One dict per statistic of a step's report (pkg/dda/solver/Statistics.def, in its order): group ('' "
+	        "for a top-level key of stats(), else its sub-dict), key, kind (C++ type), unit, doc.");
 	py::def("settingsTable", &settingsTable,
 	        "Every DDAIntegrator parameter, one dict per row of pkg/dda/solver/Settings.def: name, member (the "
 	        "IntegratorSettings attribute; None for the engine's own), kind, default, range (its text), low, high, "

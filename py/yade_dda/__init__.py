@@ -21,7 +21,7 @@ on Dask distributed).
 from ._yade import O
 from ._core import __version__  # noqa: F401  (CMakeLists.txt's project version)
 from .hooks import installHooks
-from .blocks import ddaBlock, rigidBlock, concaveBlock
+from .blocks import ddaBlock, rigidBlock, concaveBlock, boxCorners
 from .rockmass import cutRockMass
 from .engines import DDAIntegrator
 from .colliders import MSCCollider, DESSCollider, NBSCollider, AllPairsCollider
@@ -36,7 +36,7 @@ from .typedengines import typedEngines as _typedEngines
 installHooks()
 _saveload.onLoad(_typedEngines)
 
-__all__ = ['ddaBlock', 'rigidBlock', 'concaveBlock', 'cutRockMass', 'DDAIntegrator', 'MSCCollider', 'DESSCollider', 'NBSCollider', 'AllPairsCollider',
+__all__ = ['ddaBlock', 'rigidBlock', 'concaveBlock', 'boxCorners', 'cutRockMass', 'DDAIntegrator', 'MSCCollider', 'DESSCollider', 'NBSCollider', 'AllPairsCollider',
            'Checkpoint', 'latestCheckpoint', 'DDAVTKRecorder', 'stats', 'printStats', 'sync', 'block', 'blockOf',
            'setVelocity', 'addPointLoad', 'addFixedPoint', 'contacts', 'Ig2_DDABlock_DDABlock_DDAContact', 'O']
 

@@ -133,6 +133,25 @@ def _elasticConstants(material):
     return float(material.density), float(material.young), float(material.poisson), friction
 
 
+def boxCorners(lower, upper):
+    """The 8 corners [m] of the axis-aligned box from corner `lower` (x0, y0, z0) to `upper` (x1, y1, z1),
+    for ``ddaBlock`` or a ``cutRockMass`` domain. ValueError unless every coordinate is finite and
+    lower < upper on every axis. Example::
+
+        O.bodies.append(ddaBlock(boxCorners((0, 0, 0), (1, 2, 3)), material=rock))
+    """
+    try:
+        lo, hi = [tuple(float(x) for x in p) for p in (lower, upper)]
+    except (TypeError, ValueError):
+        raise TypeError('boxCorners takes two points (x, y, z) [m], got %r and %r' % (lower, upper)) from None
+    if len(lo) != 3 or len(hi) != 3:
+        raise ValueError('boxCorners takes two points (x, y, z) [m], got %r and %r' % (lower, upper))
+    for axis, a, b in zip('xyz', lo, hi):
+        if not (math.isfinite(a) and math.isfinite(b) and a < b):
+            raise ValueError('boxCorners: %s from %r to %r is not a finite, positive extent [m]' % (axis, a, b))
+    return [(x, y, z) for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])]
+
+
 def ddaBlock(vertices, material=None, fixed=False, color=None, velocity=(0, 0, 0),
              angularVelocity=(0, 0, 0), fixedPoints=(), loads=(), stress=None, mask=1, wire=False,
              cohesion=0.0, tensileStrength=0.0, rigid=False, hull=False):

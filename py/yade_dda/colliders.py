@@ -34,7 +34,7 @@ def _select(name, **parameters):
         raise ValueError('collider %r is not available in this build (available: %s)'
                          % (name, ', '.join(_settings.COLLIDERS)))
     scene = _scene.current()
-    previous = getattr(scene, 'colliderChoice', None)
+    previous = scene.colliderChoice
     if previous is None or previous[0] != O.iter - 1:
         _guards.checkColliderOrder(O.engines)   # first call, or the engine list may have changed
     # (iteration, strategy, its parameters): honoured by integratorStep at this iteration only,
@@ -156,9 +156,6 @@ class MSCCollider(_ColliderEngine):
     - ``segments``: N, the number of segments a long edge is divided into
       (default 3, >= 1).
 
-    Until the core provides MSC (``'MSC'`` in ``yade_dda.params.COLLIDERS``)
-    the constructor raises NotImplementedError; use DESSCollider meanwhile.
-
     Example::
 
         O.engines = [MSCCollider(criticalLength=0, segments=3, label='collider'), DDAIntegrator(dt=1e-3)]
@@ -172,11 +169,6 @@ class MSCCollider(_ColliderEngine):
 
     def __init__(self, *args, label='', **params):
         keywordsOnly(type(self), args)
-        if 'MSC' not in _settings.COLLIDERS:
-            raise NotImplementedError(
-                'MSCCollider: the multi-shell cover collider is not in this build of the DDA core yet '
-                '(available broad phases: %s). Use DESSCollider (same contacts) until it is.'
-                % ', '.join(_settings.COLLIDERS))
         _ColliderEngine.__init__(self, label=label, **params)
 
 

@@ -212,14 +212,14 @@ def _step(text):
     if len(scene.bodyOfBlock) != before or scene.checkedEngines != signature:
         _checkEngines(scene, engines)
         scene.checkedEngines = signature
-    choice = getattr(scene, 'colliderChoice', None)   # (iteration, name, parameters) from a collider engine
+    choice = scene.colliderChoice   # (iteration, name, parameters) from a collider engine
     fromEngine = choice is not None and choice[0] == O.iter
     collider = choice[1] if fromEngine else params['collider']
     cover = (choice[2].get('criticalLength', 0.0), choice[2].get('segments', 3)) if fromEngine else (0.0, 3)
     if scene.core.collider() != collider:
         scene.core.setCollider(collider)
         scene.cover = None
-    if collider == 'MSC' and getattr(scene, 'cover', None) != cover:
+    if collider == 'MSC' and scene.cover != cover:
         scene.core.setCover(float(cover[0]), int(cover[1]))
         scene.cover = cover
     writeDt(scene.core.step(settings))
@@ -243,7 +243,7 @@ def _progress(scene, period):
     if period <= 0:
         return
     now = time.perf_counter()
-    last = getattr(scene, 'progressMark', None)
+    last = scene.progressMark
     if last is None or O.iter < last[1]:
         scene.progressMark = (now, O.iter, O.time)
         return

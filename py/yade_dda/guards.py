@@ -40,7 +40,7 @@ def checkInitialOverlaps(scene, settings):
     Nothing is added to the core by this check; run it before resolvePending.
     """
     ready = [(body, spec) for body, spec in scene.pending if body.id >= 0]
-    first = getattr(scene, 'overlapsChecked', 0)
+    first = scene.overlapsChecked
     count = scene.core.blockCount()
     if not ready and first >= count:
         return

@@ -298,7 +298,7 @@ def unbalancedForce(useMaxForce=False):
         return original(useMaxForce)
     newton = next((e for e in O.engines if isinstance(e, wrapper.NewtonIntegrator)), None)
     yadeGravity = newton.gravity if newton is not None else None
-    settings = getattr(scene, 'settings', None)
+    settings = scene.settings
     ddaGravity = settings.gravity if settings is not None else None
     blocks = set(scene.bodyOfBlock)
     clumps = scene.clumpMembers   # a concave block: its clump's force plus its members' (their contacts)
@@ -367,6 +367,9 @@ def installHooks():
     - ``Omega.run`` and ``step``: a live NewtonIntegrator that would move DDA
       blocks while no DDAIntegrator is in O.engines is refused before YADE
       runs (guards.checkNewtonMask; with a DDAIntegrator its step checks).
+      ``run``, ``step`` and ``wait`` raise a failed DDA step's own exception
+      in place of YADE's RuntimeError('PyRunner error ...') that quotes it
+      (guards.raiseStepError).
     - ``utils.unbalancedForce`` (in yade.utils, yade._utils and the running
       script's namespace): DDA blocks count with the DDA step's gravity,
       which YADE would take from a NewtonIntegrator (unbalancedForce above).

@@ -43,7 +43,9 @@ import warnings
 from ._yade import O, utils
 
 RECORDS_ENV = 'YADE_DDA_RECORDS'
+"""The environment variable naming the directory records are written to (else the working directory)."""
 FORMAT = 1
+"""The version of a record's layout, written into every record as 'format'."""
 
 _state = {'declared': None, 'table': None, 'start': None}
 
@@ -196,9 +198,12 @@ class Record:
                                 unit=unit, note=note))
 
     def measure(self, name, value):
+        """Records `value` (a number, a vector or a list of them, SI units) under `name`, without a check."""
         self.measured[name] = _plain(value)
 
     def data(self):
+        """The record as a dict: format, description, script, table, params, checks, measured, run (steps,
+        simulated and wall time), versions and when it was written."""
         start = _state['start']
         return {
             'format': FORMAT,

@@ -69,7 +69,10 @@ class RockMass:
     refuse) that no convex merge could take, each with its ``problem`` -- not in ``blocks``, never
     dropped; ``merged``: how many slivers were merged into a neighbour; ``planes``: every plane of the
     cut (``RockPlane``); ``domainVolume`` [m^3] of the domain before excavation; ``minVolume`` [m^3] as
-    applied; ``seed``; ``stats``: counts and phase times [s] of the cut."""
+    applied; ``seed``; ``stats``: counts and phase times [s] of the cut; ``groups``: the DDA blocks as
+    tuples of indices into ``blocks`` (one for a convex block, several for a concave one of
+    ``concave=True``); ``jointArea`` and ``absentArea`` [m^2]: with ``concave=True``, the touching area
+    of non-persistent joint planes and the part of it where the joint is absent (rock bridges)."""
 
     def __init__(self, raw, seed):
         self.planes = [RockPlane(*p) for p in raw['planes']]

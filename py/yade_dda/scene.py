@@ -8,6 +8,7 @@ velocity and, for strained blocks, the local vertices of the Polyhedra shape).
 One core scene belongs to one YADE scene. It is found through a token stored in
 ``O.tags``, so ``O.reset()`` (which clears the tags) starts a fresh DDA scene.
 """
+import textwrap
 import time
 import uuid
 
@@ -21,7 +22,12 @@ _scenes = {}
 
 
 class DDAScene:
-    """Core scene plus the bookkeeping between blocks and YADE bodies."""
+    """Core scene plus the bookkeeping between blocks and YADE bodies. Every field is declared here
+    (__slots__): a module that needs another declares it, it cannot hang one on the scene."""
+
+    __slots__ = ('token', 'core', 'pending', 'bodyOfBlock', 'clumpMembers', 'syncTime', 'syncParts', 'yadeSync',
+                 'viewsStarted', 'syncedBodies', 'syncs', 'syncTimeTotal', 'stepTimeTotal', 'checkedEngines',
+                 'colliderChoice', 'cover', 'settings', 'progressMark', 'overlapsChecked', 'blockCountCache')
 
     def __init__(self, token):
         self.token = token
@@ -38,6 +44,12 @@ class DDAScene:
         self.syncTimeTotal = 0.0   # wall time of all syncs [s]
         self.stepTimeTotal = 0.0   # wall time of all engine calls, sync included [s]
         self.checkedEngines = None  # signature of the engine list last checked for conflicts
+        self.colliderChoice = None  # (iteration, strategy, its parameters) of a collider engine (colliders.py)
+        self.cover = None           # MSC's (criticalLength, segments) last given to the core (engines.py)
+        self.settings = None        # the last step's _core.IntegratorSettings (engines.py; views, sync read it)
+        self.progressMark = None    # (wall time, O.iter, O.time) of the last progress line (engines.py)
+        self.overlapsChecked = 0    # blocks of the core whose initial overlaps were checked (guards.py)
+        self.blockCountCache = None  # (core, parts, blocks) of _blockCount
 
     def register(self, body, spec):
         self.pending.append((body, spec))
@@ -127,7 +139,7 @@ class DDAScene:
         Python's garbage collector (the Python loop this replaced made a tuple of vectors per block,
         and the collector's passes took two thirds of its time at 10,000 blocks)."""
         start = time.perf_counter()
-        settings = getattr(self, 'settings', None)
+        settings = self.settings
         self.syncedBodies = self.writer().writeBodies(self.core, O.bodies, everything,
                                                       settings.threads if settings is not None else 0)
         middle = time.perf_counter()
@@ -279,90 +291,6 @@ def sync(everything=True):
 
 
 def stats():
-    """Diagnostics of the last DDA step as a dict.
-
-    Keys: ``dt`` [s] taken, ``stepCuts`` (redos with a smaller dt in that step,
-    for either reason below), ``displacementLimitMisses`` (cumulative steps
-    accepted above the bound), ``maxDisplacement`` and ``allowedDisplacement``
-    [m], ``blocks`` (DDA blocks: a concave block counts once), ``parts``
-    (their convex parts: a concave block's each), ``movingBlocks``,
-    ``unknowns`` (system size: 12 per
-    moving block, 6 per rigid one), ``rigidBlocks`` (moving rigid blocks),
-    ``strainUnknowns`` (6 per deformable moving block), ``solvedUnknowns``
-    (unknowns the last solve factorised, counted by the solver: equals
-    ``unknowns``).
-    Contacts: ``collider`` (the broad phase used: 'MSC', 'DESS', 'NBS' or
-    'AllPairs'), ``contactDistance`` [m] (d0 used), ``candidatePairs`` (block pairs
-    from the broad phase), ``shells``, ``shellPairs`` (overlapping bounding
-    volumes), ``shellTests`` (volume comparisons), ``shellUpdates``,
-    ``subUnitPairs`` (vertex-face plus edge-edge pairs the candidates offer),
-    ``subUnitTests`` (vertex-face plane tests and edge-edge tests the narrow
-    phase's search covers; a face's tests count in full even when the search
-    stops early on it), ``fullSearchPairs`` (MSC pairs searched again with every
-    sub-unit because they penetrate deeper than d0/2), ``contactPairs`` (pairs within d0), ``contacts``
-    (vertex-face and edge-edge sub-contacts), ``closedContacts``,
-    ``slidingContacts``, ``openCloseIterations`` (solves in the accepted
-    attempt), ``openCloseIterationsTotal`` (in all attempts),
-    ``stateChanges`` (changes left when the iteration stopped: 0 unless it
-    failed), ``openCloseCuts`` (dt cuts because the iteration did not
-    converge), ``openCloseFailures`` (cumulative steps accepted unconverged),
-    ``maxPenetration`` [m] (deepest closed contact), ``components`` and
-    ``largestComponent`` (independent systems solved, blocks in the largest),
-    ``lineSearches`` (solves whose step a line search shortened),
-    ``refinedComponents``, ``refineIterations`` and ``refineFallbacks``
-    (later solves of a step done by conjugate gradients preconditioned with
-    the step's first factorisation, their iterations, and those that fell
-    back to a factorisation; DDAIntegrator's refineSolves),
-    ``limitPasses``, ``limitsLowered`` and ``limitsUnsettled`` (friction-limit
-    passes after the first; groups of touching blocks whose limits did not
-    settle and ended Coulomb-safe, no friction above tan(phi) N; groups the
-    start from rest's static steps accepted with limits still moving).
-    ``settleSteps``, ``settledBlocks``, ``settleConverged``: the start from
-    rest before the first step (DDAIntegrator's startFromRest): static steps
-    made (0: nothing to settle), blocks brought to equilibrium, and whether
-    it converged (else the scene started as placed); ``unsettledBlocks``, the
-    body ids still moving when a stage gave up: the blocks no equilibrium with
-    friction locked holds (then ``settleConverged`` is False and the scene
-    started as placed), or those friction at its true value cannot hold (a
-    block that must slide: the locked state was kept); empty when it settled.
-    ``energy``: the energy account [J], each term from its own formula:
-    ``kinetic``, ``gravity`` (potential of the last step's gravity, -m g . c
-    summed over the moving blocks), ``gravityChange`` (the same less its value
-    at the blocks' initial centroids: 0 at the start, what ``O.energy``
-    shows), ``strain``, ``contact`` (springs of the closed contacts), and summed over
-    the steps ``friction`` and ``damping`` (dissipated) and ``loads`` (work of
-    point loads and fixed points); ``contactChanges`` is what the contacts'
-    springs gained between steps (new penetrating contacts, gaps linearised
-    again, springs lost when contacts vanish). kinetic + gravity + strain + contact +
-    friction + damping - loads - contactChanges is conserved (doc/guide/reference.md,
-    "The energy account").
-    ``memory``: heap bytes held after the detection: ``collider`` (the broad
-    phase's arrays: boxes, shells, grid, caches), ``contacts`` (the contact
-    store with the previous step's contacts kept for their history) and
-    ``narrowPhase`` (its per-block planes and per-pair results); and after
-    the step, ``solver`` (per moving block its solution and motion, the
-    systems of the blocks with springs, the coupled system's blocks).
-    ``time``: wall seconds per phase: broadPhase, narrowPhase, assembly,
-    solve, update, core, sync (of which syncBodies: the bodies, and syncViews:
-    interactions, forces and energy; views.py). ``cpuTime``: the process's CPU seconds (all
-    threads) in broadPhase and narrowPhase; with one thread it is the work
-    without the machine's waits, steadier than wall time on a busy machine.
-    ``syncedBodies`` and ``syncs``
-    (bodies written by the last sync, syncs so far), ``syncTimeTotal`` and
-    ``stepTimeTotal`` [s] (all syncs; all integrator calls, sync included).
-
-    Work done or skipped: ``broadPhaseSkipped`` (1 when DESS or MSC reused
-    its cached candidate or shell pairs instead of a full search),
-    ``pairsReused``,
-    ``blocksResearched`` (blocks searched again; all on a full search),
-    ``fixedPairsSearched`` (pairs of two fixed blocks given to the narrow
-    phase: always 0), ``frictionTerms`` and ``normalTerms`` (shear springs or
-    friction loads, and normal springs, assembled over all solves of the
-    step), ``bodyForceBlocks`` (block assemblies with gravity),
-    ``frictionContacts`` (contacts with a friction coefficient > 0),
-    ``bondedContacts``, ``fixedBlocks``, ``staticAnalysis``
-    (velocityRatio == 0). ``effects`` sums them up, see ``effects()``.
-    """
     scene = _require()
     result = scene.core.lastStep()
     result['parts'] = result['blocks']   # the core counts convex parts
@@ -382,10 +310,97 @@ def stats():
     return result
 
 
+# What stats() adds to the core's report (_core.statisticsTable(), from pkg/dda/solver/Statistics.def),
+# or says of it in the user's terms: (group, key, unit, doc), group '' for a top-level key.
+_PYTHON_STATS = (
+    ('', 'blocks', '', 'DDA blocks (a concave block counts once)'),
+    ('', 'parts', '', 'their convex parts (a concave block\'s each)'),
+    ('', 'collider', '', "the broad phase used: 'MSC', 'DESS', 'NBS' or 'AllPairs'"),
+    ('', 'steps', '', 'DDA steps taken so far'),
+    ('', 'pendingBodies', '', 'DDA blocks appended that enter the core at the next step'),
+    ('', 'unsettledBlocks', '', 'body ids the start from rest could not hold: with friction locked (the scene '
+     'started as placed, settleConverged False) or at its true value (blocks that must slide: the locked state '
+     'was kept); empty when it settled'),
+    ('', 'syncedBodies', '', 'bodies written by the last sync'),
+    ('', 'syncs', '', 'syncs so far'),
+    ('', 'syncTimeTotal', 's', 'wall time of all syncs'),
+    ('', 'stepTimeTotal', 's', 'wall time of all integrator calls, syncs included'),
+    ('time', 'sync', 's', 'wall time of the last sync'),
+    ('time', 'syncBodies', 's', 'of which writing the bodies'),
+    ('time', 'syncViews', 's', 'of which interactions, forces and energy (views.py)'),
+    ('energy', 'kinetic', 'J', 'kinetic energy now'),
+    ('energy', 'gravity', 'J', "potential of the last step's gravity, -m g . c summed over the moving blocks"),
+    ('energy', 'gravityChange', 'J', "the same less its value at the blocks' initial centroids (0 at the start; "
+     "O.energy's ddaGravity)"),
+    ('energy', 'strain', 'J', "the blocks' elastic energy now"),
+    ('energy', 'contact', 'J', "the closed contacts' springs now"),
+    ('energy', 'friction', 'J', 'dissipated by sliding (cumulative)'),
+    ('energy', 'damping', 'J', 'dissipated by the time scheme, strain viscosity and velocityRatio < 1 (cumulative)'),
+    ('energy', 'loads', 'J', 'work of point loads and fixed points (cumulative)'),
+    ('energy', 'contactChanges', 'J', "what the contacts' springs gained between steps: new penetrating contacts, "
+     'gaps linearised again, springs lost when contacts vanish (cumulative). kinetic + gravity + strain + '
+     'contact + friction + damping - loads - contactChanges is conserved (doc/guide/reference.md, "The energy '
+     'account")'),
+    ('memory', 'collider', 'bytes', "the broad phase's arrays (boxes, shells, grid, caches), after the detection"),
+    ('memory', 'contacts', 'bytes', "the contact store, the previous step's contacts kept for their history"),
+    ('memory', 'narrowPhase', 'bytes', 'per-block planes and per-pair results'),
+    ('memory', 'solver', 'bytes', 'per moving block its solution and motion, the systems of the blocks with '
+     'springs, the coupled system\'s blocks (after the step)'),
+    ('effects', 'friction', '', 'some contact has a friction angle > 0'),
+    ('effects', 'gravity', '', 'a body force was assembled'),
+    ('effects', 'static', '', 'velocityRatio == 0'),
+    ('effects', 'bonds', '', 'some contact is a bonded joint'),
+    ('effects', 'fixedBlocks', '', 'blocks without unknowns (never paired together)'),
+    ('effects', 'restingReuse', '', 'the broad phase was served from its pair cache'),
+    ('effects', 'rigidBlocks', '', 'blocks with 6 unknowns'),
+)
+
+_STATS_GROUPS = (('', 'The step, its contacts and solves'),
+                 ('time', "``time``: wall seconds per phase"),
+                 ('cpuTime', "``cpuTime``: the process's CPU seconds (all threads) in the contact detection; with "
+                             "one thread the work without the machine's waits, steadier than wall time"),
+                 ('energy', '``energy``: the energy account, each term from its own formula'),
+                 ('memory', '``memory``: heap bytes held'),
+                 ('effects', "``effects``: which effects the last step simulated (what it paid for), from the "
+                             "counters above"))
+
+
+def statisticsRows():
+    """Every key of stats() as (group, key, unit, doc): the core's rows (pkg/dda/solver/Statistics.def) with
+    what stats() says or adds in the user's terms (_PYTHON_STATS) in place of or after them."""
+    own = {(g, k): (g, k, u, d) for g, k, u, d in _PYTHON_STATS}
+    rows, seen = [], set()
+    for row in _core.statisticsTable():
+        key = (row['group'], row['key'])
+        rows.append(own.get(key, (row['group'], row['key'], row['unit'], row['doc'])))
+        seen.add(key)
+    rows += [r for r in _PYTHON_STATS if (r[0], r[1]) not in seen]
+    return rows
+
+
+def _statsDoc():
+    """stats()'s docstring: the rows of statisticsRows by group."""
+    def fill(text, first='', later=''):
+        return textwrap.fill(text, 100, initial_indent='    ' + first, subsequent_indent='    ' + later)
+    lines = ['Diagnostics of the last DDA step as a dict (SI units).', '',
+             fill('Generated from the core\'s declaration of the step\'s report (pkg/dda/solver/Statistics.def) '
+                  'and what the package adds (scene._PYTHON_STATS). "all attempts": over every attempt of the step '
+                  '(a step cut redoes it); "cumulative": over the run.')]
+    rows = statisticsRows()
+    for group, title in _STATS_GROUPS:
+        lines += ['', fill(title + ':'), '']
+        lines += [fill('``%s``%s: %s' % (key, ' [%s]' % unit if unit else '', doc), '- ', '  ')
+                  for g, key, unit, doc in rows if g == group]
+    return '\n'.join(lines) + '\n    '
+
+
+stats.__doc__ = _statsDoc()
+
+
 def _blockCount(scene, parts):
     """The DDA blocks among the core's first `parts` convex parts (a concave block's parts follow its
     first, which is its body: core.bodyOf), cached per core and part count (parts are only appended)."""
-    cached = getattr(scene, 'blockCountCache', None)
+    cached = scene.blockCountCache
     if cached is None or cached[0] is not scene.core or cached[1] != parts:
         bodyOf = scene.core.bodyOf
         cached = scene.blockCountCache = (scene.core, parts, sum(1 for i in range(parts) if bodyOf(i) == i))
@@ -439,7 +454,7 @@ class BlockView:
     stress = property(lambda self: self._core.stress(self.index), doc='(sxx, syy, szz, sxy, syz, szx) [Pa]')
     strain = property(lambda self: self._core.strain(self.index), doc='accumulated (ex, ey, ez, gxy, gyz, gzx) [-]')
     rotation = property(lambda self: self._core.rotation(self.index), doc='rotation since creation (Quaternion)')
-    fixed = property(lambda self: self._core.isFixed(self.index))
+    fixed = property(lambda self: self._core.isFixed(self.index), doc='True for a fixed block (no unknowns)')
     rigid = property(lambda self: self._core.isRigid(self.index), doc='a rigid block: 6 unknowns, no strain or stress')
     partCount = property(lambda self: 1, doc='number of convex parts (concaveBlock: more than 1)')
     parts = property(lambda self: [self.vertices], doc="each convex part's current corners [m]")
@@ -550,6 +565,8 @@ class Ig2_DDABlock_DDABlock_DDAContact:
     """
 
     def go(self, body1, body2, contactDistance=0.0):
+        """The pair's contact at the blocks' current geometry within contactDistance [m] (a dict, see the
+        class), or None when they are farther apart."""
         scene = _require()
         # A concave block's member: its own part (the clump stands for its first part).
         scene.blockIndex(body1), scene.blockIndex(body2)   # KeyError for a body that is no DDA block

@@ -25,8 +25,8 @@ def tag(name):
 def encodeState(scene):
     """The tag text holding a DDA scene's full state (see the module docstring)."""
     info = dict(token=scene.token, iter=O.iter, steps=scene.core.steps(), bodies=scene.bodyOfBlock,
-                cover=list(scene.cover) if getattr(scene, 'cover', None) is not None else None,
-                checked=getattr(scene, 'overlapsChecked', 0))
+                cover=list(scene.cover) if scene.cover is not None else None,
+                checked=scene.overlapsChecked)
     infoBytes = json.dumps(info, separators=(',', ':')).encode('utf-8')
     raw = struct.pack('<Q', len(infoBytes)) + infoBytes + scene.core.saveState()
     return FORMAT + ' ' + base64.b64encode(zlib.compress(raw, 1)).decode('ascii')

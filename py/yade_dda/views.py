@@ -64,7 +64,7 @@ def update(scene, engines=None):
     (pkg/py/YadeSync.hpp: what it keeps of YADE's objects, and why that holds)."""
     if not _enabled:
         return
-    settings = getattr(scene, 'settings', None) or _DEFAULT_SETTINGS
+    settings = scene.settings or _DEFAULT_SETTINGS
     writer = scene.writer()
     engines = O.engines if engines is None else engines
     keep = not any(_runsPolyhedraFunctor(e) for e in engines)

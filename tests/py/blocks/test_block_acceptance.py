@@ -299,3 +299,18 @@ def test_block_resting_on_floor_far_from_origin_settles_as_at_origin(scene, shap
     assert contacts == contacts0 >= 4
     assert drift0 <= 1e-9 * sink0 and drift <= 1e-3 * sink0 + roundoff
     assert abs(sink - sink0) <= 1e-3 * sink0 + roundoff
+
+
+def test_box_corners_are_the_eight_corners_of_the_box(scene):
+    """boxCorners gives the 8 corners of an axis-aligned box (a block of its volume and centroid) and
+    refuses an empty, inverted or non-finite extent by name."""
+    import math
+    corners = yade_dda.boxCorners((0, 0, 10), (1, 2, 13))
+    assert sorted(corners) == sorted((x, y, z) for x in (0.0, 1.0) for y in (0.0, 2.0) for z in (10.0, 13.0))
+    body = O.bodies.append(yade_dda.ddaBlock(corners))
+    view = yade_dda.block(body)
+    assert abs(view.volume - 6.0) < 1e-12 and max(abs(a - b) for a, b in zip(view.centroid, (0.5, 1, 11.5))) < 1e-12
+    for lower, upper, message in [((0, 0, 0), (1, 0, 1), 'y from 0.0 to 0.0'), ((0, 0, 0), (1, 1, -1), 'z from'),
+                                  ((0, 0, 0), (1, math.nan, 1), 'y from'), ((0, 0), (1, 1), 'two points')]:
+        with pytest.raises(ValueError, match=message):
+            yade_dda.boxCorners(lower, upper)

@@ -12,7 +12,7 @@ draw_sliding):
   vertical mid-plane y = 0 (x anywhere on the block, z in the band below), gravity
   (0, 0, -g). Closed form: a = (F - mu m g) / m along +x;
 - 'sliding': the same kind of block on a slope of 25..40 deg (gravity tilted about y
-  instead of the slope, as README's second example), phi 10..(slope - 5) deg.
+  instead of the slope, as the tutorial's block on a slope), phi 10..(slope - 5) deg.
   Closed form: a = g (sin slope - tan phi cos slope) along +x.
 
 Neither may tip. A rigid block sliding under these forces turns only if the base's
