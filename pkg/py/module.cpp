@@ -504,6 +504,41 @@ void registerScene() {
 	registerConcaveBlocks(scene);
 }
 
+// _core.YadeSync (pkg/py/YadeSync.hpp).
+void registerYadeSync() {
+	py::class_<YadeSync, boost::noncopyable>(
+	    "YadeSync",
+	    "Writes a Scene's state into YADE's containers from C++ (pkg/py/YadeSync.hpp): body states and shapes, "
+	    "O.forces, O.interactions. One per DDA scene; it keeps YADE's objects it wrote to.",
+	    py::init<py::object, py::object, py::object>(
+	        (py::arg("geomClass"), py::arg("physClass"), py::arg("createInteraction"))))
+	    .def("writeBodies", &YadeSync::writeBodies,
+	         (py::arg("scene"), py::arg("bodies"), py::arg("all"), py::arg("threads") = 0),
+	         "Writes moving blocks' (every block's if all) pos, ori, vel, angVel and, when strained, vertices into "
+	         "their bodies (bodies: O.bodies); returns how many. The values are computed on `threads` threads "
+	         "(0: OpenMP's count) from 1024 blocks on, and written from the calling thread.")
+	    .def("writeViews", &YadeSync::writeViews,
+	         (py::arg("scene"), py::arg("settings"), py::arg("forces"), py::arg("interactions"), py::arg("keep"),
+	          py::arg("foreign")),
+	         "Makes O.forces (forces) hold each block's force [N] and torque about its centroid [N m], gravity "
+	         "excluded, and O.interactions (interactions) a real interaction per body pair with a closed contact "
+	         "(none unless keep); foreign: [(id1, id2)] DDA pairs already there that it did not make. One pass over "
+	         "the contacts; returns the pair count.")
+	    .def("forgetBodies", &YadeSync::forgetBodies, "A body's state or shape object was replaced.")
+	    .def("forgetInteractions", &YadeSync::forgetInteractions, "A script cleared O.interactions.")
+	    .def("forgetInteraction", &YadeSync::forgetInteraction, (py::arg("id1"), py::arg("id2")),
+	         "A script erased this interaction.")
+	    .def("counters", +[](const YadeSync& y) {
+		    const YadeSync::Counters c = y.counters();
+		    py::dict out;
+		    out["bodiesKept"] = c.bodiesKept;
+		    out["interactionsKept"] = c.interactionsKept;
+		    out["forceReadBacks"] = c.forceReadBacks;
+		    return out;
+	    }, "bodiesKept, interactionsKept: blocks and pairs whose YADE objects are kept; forceReadBacks: syncs "
+	       "that read O.forces back because its probe disagreed.");
+}
+
 }  // namespace
 
 BOOST_PYTHON_MODULE(_core) {
@@ -555,35 +590,5 @@ BOOST_PYTHON_MODULE(_core) {
 
 	registerScene();
 
-	py::class_<YadeSync, boost::noncopyable>(
-	    "YadeSync",
-	    "Writes a Scene's state into YADE's containers from C++ (pkg/py/YadeSync.hpp): body states and shapes, "
-	    "O.forces, O.interactions. One per DDA scene; it keeps YADE's objects it wrote to.",
-	    py::init<py::object, py::object, py::object>(
-	        (py::arg("geomClass"), py::arg("physClass"), py::arg("createInteraction"))))
-	    .def("writeBodies", &YadeSync::writeBodies,
-	         (py::arg("scene"), py::arg("bodies"), py::arg("all"), py::arg("threads") = 0),
-	         "Writes moving blocks' (every block's if all) pos, ori, vel, angVel and, when strained, vertices into "
-	         "their bodies (bodies: O.bodies); returns how many. The values are computed on `threads` threads "
-	         "(0: OpenMP's count) from 1024 blocks on, and written from the calling thread.")
-	    .def("writeViews", &YadeSync::writeViews,
-	         (py::arg("scene"), py::arg("settings"), py::arg("forces"), py::arg("interactions"), py::arg("keep"),
-	          py::arg("foreign")),
-	         "Makes O.forces (forces) hold each block's force [N] and torque about its centroid [N m], gravity "
-	         "excluded, and O.interactions (interactions) a real interaction per body pair with a closed contact "
-	         "(none unless keep); foreign: [(id1, id2)] DDA pairs already there that it did not make. One pass over "
-	         "the contacts; returns the pair count.")
-	    .def("forgetBodies", &YadeSync::forgetBodies, "A body's state or shape object was replaced.")
-	    .def("forgetInteractions", &YadeSync::forgetInteractions, "A script cleared O.interactions.")
-	    .def("forgetInteraction", &YadeSync::forgetInteraction, (py::arg("id1"), py::arg("id2")),
-	         "A script erased this interaction.")
-	    .def("counters", +[](const YadeSync& y) {
-		    const YadeSync::Counters c = y.counters();
-		    py::dict out;
-		    out["bodiesKept"] = c.bodiesKept;
-		    out["interactionsKept"] = c.interactionsKept;
-		    out["forceReadBacks"] = c.forceReadBacks;
-		    return out;
-	    }, "bodiesKept, interactionsKept: blocks and pairs whose YADE objects are kept; forceReadBacks: syncs "
-	       "that read O.forces back because its probe disagreed.");
+	registerYadeSync();
 }

@@ -51,6 +51,23 @@ bool coveredOnly(const Prepared& a, const Prepared& b, const AxisSearch& axes, d
 }
 }  // namespace
 
+namespace {
+// The pair as two plain convex blocks (no face internal, no cover), after a
+// full search when it came with linked sub-units (coveredOnly).
+bool detectAsPlainBlocks(const BlockGeometry& blockA, const BlockGeometry& blockB, const DetectionSettings& settings,
+                         PairContacts& out, const EntranceFeature& previous, const LinkedSubUnits* linked,
+                         NarrowPhaseWork* work) {
+	if (linked) {
+		++work->fullSearches;
+		return detectPairContacts(blockA, blockB, settings, out, previous, nullptr, work);
+	}
+	BlockGeometry plainA = blockA, plainB = blockB;
+	plainA.internalFaces = plainB.internalFaces = nullptr;
+	plainA.covers = plainB.covers = nullptr;
+	return detectPairContacts(plainA, plainB, settings, out, previous, nullptr, work);
+}
+}  // namespace
+
 bool detectPairContacts(const BlockGeometry& blockA, const BlockGeometry& blockB, const DetectionSettings& settings,
                         PairContacts& out, const EntranceFeature& previous, const LinkedSubUnits* linked,
                         NarrowPhaseWork* work) {
@@ -92,16 +109,7 @@ bool detectPairContacts(const BlockGeometry& blockA, const BlockGeometry& blockB
 
 	// A pair that touches only where covered faces meet the surface is two
 	// plain convex blocks (coveredOnly); the full search decides that.
-	if (coveredOnly(a, b, axes, d0)) {
-		if (linked) {
-			++work->fullSearches;
-			return detectPairContacts(blockA, blockB, settings, out, previous, nullptr, work);
-		}
-		BlockGeometry plainA = blockA, plainB = blockB;
-		plainA.internalFaces = plainB.internalFaces = nullptr;
-		plainA.covers = plainB.covers = nullptr;
-		return detectPairContacts(plainA, plainB, settings, out, previous, nullptr, work);
-	}
+	if (coveredOnly(a, b, axes, d0)) return detectAsPlainBlocks(blockA, blockB, settings, out, previous, linked, work);
 
 	// 2. The entrance feature (Entrance.hpp).
 	Entrance entrance = chooseEntrance(faces, axes, a, b, tol, hysteresis, previous);

@@ -249,15 +249,15 @@ bool searchFaceAxes(const Prepared& a, const Prepared& b, double d0, double hyst
 // has no contact, and a sub-contact below minus the true penetration would
 // still have a negative gap after a translation that separates the blocks.
 // Removing a contact leaves no spring, so it creates no energy.
-bool searchEdgeAxes(const Prepared& a, const Prepared& b, double d0, double sinTolerance,
-                    const EntranceFeature& previous, Scratch& s, AxisSearch& axes) {
-	// The faces of B at its usable edges (their planes are built:
-	// prepareEdges), minus their normals (C, D), and those edges with their
-	// two faces, in edgeList order.
+namespace {
+// searchEdgeAxes' first part: the faces of B at its usable edges (their
+// planes are built: prepareEdges), minus their normals (C, D), and those
+// edges with their two faces, in edgeList order (s.edgeFacesB,
+// s.inwardNormalsB, s.edgesB).
+void gatherEdgesOfB(const Prepared& b, Scratch& s) {
 	std::vector<int>& bFaces = s.edgeFacesB;
 	std::vector<Vector3>& inward = s.inwardNormalsB;
 	std::vector<std::array<int, 3>>& bEdges = s.edgesB;
-	std::vector<int>& side = s.arcSides;
 	std::vector<char>& mark = s.faceMark;
 	mark.assign(b.faceCount(), 0);
 	bFaces.clear();
@@ -273,15 +273,15 @@ bool searchEdgeAxes(const Prepared& a, const Prepared& b, double d0, double sinT
 			inward.push_back(-b.faces[g].normal);
 		}
 	}
-	side.resize(b.faceCount());
-	const int usable = static_cast<int>(bEdges.size());
-	const int faceTotal = static_cast<int>(bFaces.size());
-	s.crossingEdges.resize(usable);
-	int* crossing = s.crossingEdges.data();
-	// adc, bdc: per face of A at a usable edge of A (row faceRow[f]), the
-	// signs of n_f . (D x C) for each usable edge of B.
+}
+
+// Its second: adc, bdc, per face of A at a usable edge of A (row
+// s.faceRows[f]), the signs of n_f . (D x C) for each of the `usable` edges
+// of B (s.faceSigns).
+void faceSignsOfA(const Prepared& a, const Prepared& b, int usable, Scratch& s) {
 	std::vector<int>& faceRow = s.faceRows;
 	std::vector<int>& faceSigns = s.faceSigns;
+	const std::vector<std::array<int, 3>>& bEdges = s.edgesB;
 	faceRow.assign(a.faceCount(), -1);
 	int rows = 0;
 	for (int ea : a.edgeList) {
@@ -303,6 +303,24 @@ bool searchEdgeAxes(const Prepared& a, const Prepared& b, double d0, double sinT
 			row[k] = sign;
 		}
 	}
+}
+}  // namespace
+
+bool searchEdgeAxes(const Prepared& a, const Prepared& b, double d0, double sinTolerance,
+                    const EntranceFeature& previous, Scratch& s, AxisSearch& axes) {
+	gatherEdgesOfB(b, s);
+	const std::vector<int>& bFaces = s.edgeFacesB;
+	const std::vector<Vector3>& inward = s.inwardNormalsB;
+	const std::vector<std::array<int, 3>>& bEdges = s.edgesB;
+	std::vector<int>& side = s.arcSides;
+	side.resize(b.faceCount());
+	const int usable = static_cast<int>(bEdges.size());
+	const int faceTotal = static_cast<int>(bFaces.size());
+	s.crossingEdges.resize(usable);
+	int* crossing = s.crossingEdges.data();
+	faceSignsOfA(a, b, usable, s);
+	const std::vector<int>& faceRow = s.faceRows;
+	const std::vector<int>& faceSigns = s.faceSigns;
 	for (int ea : a.edgeList) {
 		const bool internalA = a.internalEdge(ea);
 		const auto& fa = a.shape->edgeFaces[ea];

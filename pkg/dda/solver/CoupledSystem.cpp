@@ -301,6 +301,29 @@ std::size_t CoupledSystem::membersHash(int c) const {
 	return patternHash(members_.begin() + componentStart_[c], members_.begin() + componentStart_[c + 1]);
 }
 
+double CoupledSystem::componentNorm(int c) const {
+	// |K| (infinity norm: the largest absolute row sum), over the rows of the
+	// restricted system (a rigid block's strain rows are the identity's,
+	// left out).
+	const int first = componentStart_[c], n = componentStart_[c + 1] - first;
+	std::vector<Vector12> rowSums(n, Vector12::Zero());
+	for (int k = 0; k < n; ++k) {
+		const Matrix12 lower = diagonal_[first + k].selfadjointView<Eigen::Lower>();
+		rowSums[k] += lower.cwiseAbs().rowwise().sum();
+	}
+	for (int l = linkStart_[c]; l < linkStart_[c + 1]; ++l) {
+		const int lo = linkSlots_[l].first - first, hi = linkSlots_[l].second - first;
+		rowSums[lo] += offDiagonal_[l].cwiseAbs().rowwise().sum();
+		rowSums[hi] += offDiagonal_[l].cwiseAbs().colwise().sum().transpose();
+	}
+	double largest = 0;
+	for (int k = 0; k < n; ++k) {
+		if (unknowns_[first + k] != kBlockDofs) rowSums[k].tail<kBlockDofs - kRigidBlockDofs>().setZero();
+		largest = std::max(largest, rowSums[k].lpNorm<Eigen::Infinity>());
+	}
+	return largest;
+}
+
 bool CoupledSystem::refineComponent(int c, const BlockCholesky& factor, int maxIterations,
                                     std::vector<Vector12>& solutions, int& iterations) const {
 	const int first = componentStart_[c], last = componentStart_[c + 1], n = last - first;
@@ -332,19 +355,7 @@ bool CoupledSystem::refineComponent(int c, const BlockCholesky& factor, int maxI
 		for (int k = 0; k < n; ++k) m = std::max(m, a[k].lpNorm<Eigen::Infinity>());
 		return m;
 	};
-	// |K| (infinity norm: the largest absolute row sum), over the restricted rows.
-	std::vector<Vector12> rowSums(n, Vector12::Zero());
-	for (int k = 0; k < n; ++k) {
-		const Matrix12 lower = diagonal_[first + k].selfadjointView<Eigen::Lower>();
-		rowSums[k] += lower.cwiseAbs().rowwise().sum();
-	}
-	for (int l = linkFirst; l < linkLast; ++l) {
-		const int lo = linkSlots_[l].first - first, hi = linkSlots_[l].second - first;
-		rowSums[lo] += offDiagonal_[l].cwiseAbs().rowwise().sum();
-		rowSums[hi] += offDiagonal_[l].cwiseAbs().colwise().sum().transpose();
-	}
-	restrictRigid(rowSums);
-	const double normK = largest(rowSums);
+	const double normK = componentNorm(c);
 
 	std::vector<Vector12> b(force_.begin() + first, force_.begin() + last);
 	restrictRigid(b);
@@ -416,109 +427,65 @@ bool CoupledSystem::iterateComponent(int c, std::vector<Vector12>& solutions, in
 	return true;
 }
 
-void CoupledSystem::solve(std::vector<Vector12>& solutions, int threadsFrom) {
-	++solves_;
+void CoupledSystem::iterateLargeComponents(std::vector<Vector12>& solutions, int threadsFrom,
+                                           std::vector<char>& iterated, long& solved) {
+	// One component after another, each threaded over its rows (inside the
+	// components' parallel loop it would run on one thread); one that does
+	// not converge is factorised by solveOtherComponents.
 	const int count = components();
-	bool failed = false;
-	// An integer sum, exact in any order: the count does not depend on the thread count.
-	long solved = 0;
-	int reusedAnalyses = 0, newAnalyses = 0, refined = 0, refineIterations = 0, fallbacks = 0;
-	int iterated = 0, iterativeIterations = 0, iterativeFallbacks = 0;
-	// The iterative path first, one component after another, each threaded
-	// over its rows (inside the components' parallel loop below it would
-	// run on one thread); one that does not converge is factorised below.
-	std::vector<char> iteratedHere(count, 0);
+	iterated.assign(count, 0);
+	int done = 0, iterations = 0, fallbacks = 0;
 	for (int c = 0; iterativeFrom_ > 0 && c < count; ++c) {
 		const int first = componentStart_[c], last = componentStart_[c + 1];
 		if (last - first < std::max(iterativeFrom_, 2)) continue;
-		int iterations = 0;
-		iteratedHere[c] = iterateComponent(c, solutions, iterations, threadsFrom);
-		iterativeIterations += iterations;
-		if (iteratedHere[c]) {
-			++iterated;
+		int its = 0;
+		iterated[c] = iterateComponent(c, solutions, its, threadsFrom);
+		iterations += its;
+		if (iterated[c]) {
+			++done;
 			for (int s = first; s < last; ++s) solved += unknowns_[s];
 		} else {
-			++iterativeFallbacks;
+			++fallbacks;
 		}
 	}
-	// Refinement's preconditioners, found before the components run in parallel.
-	std::vector<Analysis*> preconditioner(count, nullptr);
-	std::vector<char> factored(count, 0);
-	if (refine_ && reuse_)
-		for (int c = 0; c < count; ++c)
-			if (componentStart_[c + 1] - componentStart_[c] >= kMinRefineBlocks) preconditioner[c] = preconditionerFor(c);
-#pragma omp parallel for schedule(dynamic) \
-    reduction(+ : solved, reusedAnalyses, newAnalyses, refined, refineIterations, fallbacks, iterated, \
-                  iterativeIterations, iterativeFallbacks) if (count >= threadsFrom)
-	for (int c = 0; c < count; ++c) {
-		if (iteratedHere[c]) continue;
-		const int first = componentStart_[c], last = componentStart_[c + 1];
-		if (last - first == 1) {
-			solved += unknowns_[first];
-			if (!solveSingleBlock(first, solutions)) {
-#pragma omp atomic write
-				failed = true;
-			}
-			continue;
-		}
-		for (int s = first; s < last; ++s) solved += unknowns_[s];
-		if (const Analysis* from = preconditioner[c]) {
-			// A budget of iterations that cost about one factorisation: a
-			// product of the factorisation is 12 matrix-vector products, an
-			// iteration 2 per factor block (the preconditioner's solve),
-			// about 3 per diagonal block and 2 per link (K p), and runs at
-			// about half the products' rate (measured: a dense 66-block
-			// factorisation costs 29 iterations, 40 blocks at half density
-			// 20, 20 blocks at 30 % 9; the budgets are 32, 22, 8).
-			const long perIteration = 2 * from->cholesky.factorBlocks() + 3 * (last - first) +
-			                          2 * (linkStart_[c + 1] - linkStart_[c]);
-			const long budget = std::min<long>(kMaxRefineIterations, 6 * from->cholesky.factorProducts() / perIteration);
-			int iterations = 0;
-			if (budget >= 2) {
-				const bool converged = refineComponent(c, from->cholesky, static_cast<int>(budget), solutions, iterations);
-				refineIterations += iterations;
-				if (converged) {
-					++refined;
-					continue;
-				}
-				++fallbacks;
-			}
-		}
-		Analysis* analysis = componentAnalysis_.empty() ? nullptr : componentAnalysis_[c];
-		bool solvedHere;
-		if (analysis) {
-			factored[c] = 1;
-			const bool analyse = !analysis->analysed;
-			solvedHere = solveComponent(c, analysis->cholesky, analyse, solutions);
-			if (analyse) {
-				analysis->analysed = true;
-				analysis->bytes = analysis->cholesky.memoryBytes();
-				++newAnalyses;
-			} else {
-				++reusedAnalyses;
-			}
-		} else {
-			BlockCholesky cholesky;
-			solvedHere = solveComponent(c, cholesky, true, solutions);
-		}
-		if (!solvedHere) {
-#pragma omp atomic write
-			failed = true;
-		}
+	iterativeComponents_ = done;
+	iterativeIterations_ = iterations;
+	iterativeFallbacks_ = fallbacks;
+}
+
+long CoupledSystem::refineBudget(int c, const Analysis& from) const {
+	// A budget of iterations that cost about one factorisation: a product of
+	// the factorisation is 12 matrix-vector products, an iteration 2 per
+	// factor block (the preconditioner's solve), about 3 per diagonal block
+	// and 2 per link (K p), and runs at about half the products' rate
+	// (measured: a dense 66-block factorisation costs 29 iterations, 40
+	// blocks at half density 20, 20 blocks at 30 % 9; the budgets are 32,
+	// 22, 8).
+	const long perIteration = 2 * from.cholesky.factorBlocks() + 3 * (componentStart_[c + 1] - componentStart_[c]) +
+	                          2 * (linkStart_[c + 1] - linkStart_[c]);
+	return std::min<long>(kMaxRefineIterations, 6 * from.cholesky.factorProducts() / perIteration);
+}
+
+bool CoupledSystem::factorComponent(int c, std::vector<Vector12>& solutions, bool& analysed) {
+	Analysis* analysis = componentAnalysis_.empty() ? nullptr : componentAnalysis_[c];
+	analysed = false;
+	if (!analysis) {
+		BlockCholesky cholesky;
+		return solveComponent(c, cholesky, true, solutions);
 	}
-	if (failed) throw std::runtime_error("the DDA system is not positive definite (Cholesky failed)");
-	solvedUnknowns_ = solved;
-	reusedAnalyses_ = reusedAnalyses;
-	newAnalyses_ = newAnalyses;
-	refinedComponents_ = refined;
-	refineIterations_ = refineIterations;
-	refineFallbacks_ = fallbacks;
-	iterativeComponents_ = iterated;
-	iterativeIterations_ = iterativeIterations;
-	iterativeFallbacks_ = iterativeFallbacks;
-	warm_ = true;
+	const bool analyse = !analysis->analysed;
+	const bool solvedHere = solveComponent(c, analysis->cholesky, analyse, solutions);
+	if (analyse) {
+		analysis->analysed = true;
+		analysis->bytes = analysis->cholesky.memoryBytes();
+		analysed = true;
+	}
+	return solvedHere;
+}
+
+void CoupledSystem::keepFactors(const std::vector<char>& factored) {
 	// The factors made now precondition the attempt's later solves of the same blocks.
-	for (int c = 0; c < count; ++c) {
+	for (int c = 0; c < components(); ++c) {
 		if (!factored[c] || !refine_ || componentStart_[c + 1] - componentStart_[c] < kMinRefineBlocks) continue;
 		Analysis* a = componentAnalysis_[c];
 		a->factoredMembers.assign(members_.begin() + componentStart_[c], members_.begin() + componentStart_[c + 1]);
@@ -532,6 +499,69 @@ void CoupledSystem::solve(std::vector<Vector12>& solutions, int threadsFrom) {
 			}
 		factorByMembers_.emplace(a->membersHash, a);
 	}
+}
+
+void CoupledSystem::solve(std::vector<Vector12>& solutions, int threadsFrom) {
+	++solves_;
+	const int count = components();
+	bool failed = false;
+	// An integer sum, exact in any order: the count does not depend on the thread count.
+	long solved = 0;
+	int reusedAnalyses = 0, newAnalyses = 0, refined = 0, refineIterations = 0, fallbacks = 0;
+	std::vector<char> iteratedHere;
+	iterateLargeComponents(solutions, threadsFrom, iteratedHere, solved);
+	// Refinement's preconditioners, found before the components run in parallel.
+	std::vector<Analysis*> preconditioner(count, nullptr);
+	std::vector<char> factored(count, 0);
+	if (refine_ && reuse_)
+		for (int c = 0; c < count; ++c)
+			if (componentStart_[c + 1] - componentStart_[c] >= kMinRefineBlocks) preconditioner[c] = preconditionerFor(c);
+#pragma omp parallel for schedule(dynamic) \
+    reduction(+ : solved, reusedAnalyses, newAnalyses, refined, refineIterations, fallbacks) if (count >= threadsFrom)
+	for (int c = 0; c < count; ++c) {
+		if (iteratedHere[c]) continue;
+		const int first = componentStart_[c], last = componentStart_[c + 1];
+		for (int s = first; s < last; ++s) solved += unknowns_[s];
+		if (last - first == 1) {
+			if (!solveSingleBlock(first, solutions)) {
+#pragma omp atomic write
+				failed = true;
+			}
+			continue;
+		}
+		if (const Analysis* from = preconditioner[c]) {
+			const long budget = refineBudget(c, *from);
+			int iterations = 0;
+			if (budget >= 2) {
+				const bool converged = refineComponent(c, from->cholesky, static_cast<int>(budget), solutions, iterations);
+				refineIterations += iterations;
+				if (converged) {
+					++refined;
+					continue;
+				}
+				++fallbacks;
+			}
+		}
+		bool analysed = false;
+		const bool solvedHere = factorComponent(c, solutions, analysed);
+		if (!componentAnalysis_.empty() && componentAnalysis_[c]) {
+			factored[c] = 1;
+			++(analysed ? newAnalyses : reusedAnalyses);
+		}
+		if (!solvedHere) {
+#pragma omp atomic write
+			failed = true;
+		}
+	}
+	if (failed) throw std::runtime_error("the DDA system is not positive definite (Cholesky failed)");
+	solvedUnknowns_ = solved;
+	reusedAnalyses_ = reusedAnalyses;
+	newAnalyses_ = newAnalyses;
+	refinedComponents_ = refined;
+	refineIterations_ = refineIterations;
+	refineFallbacks_ = fallbacks;
+	warm_ = true;
+	keepFactors(factored);
 }
 
 }  // namespace dda

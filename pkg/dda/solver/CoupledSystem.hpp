@@ -184,6 +184,8 @@ private:
 	// true when converged (`iterations` the count either way).
 	bool refineComponent(int c, const BlockCholesky& factor, int maxIterations, std::vector<Vector12>& solutions,
 	                     int& iterations) const;
+	// |K| of component c: the infinity norm of its restricted system.
+	double componentNorm(int c) const;
 	// The kept analysis holding a factor of this attempt for component c's
 	// blocks that no other component of this build uses, or null.
 	Analysis* preconditionerFor(int c) const;
@@ -225,6 +227,17 @@ private:
 	int iterativeComponents_ = 0, iterativeIterations_ = 0, iterativeFallbacks_ = 0;
 	// Solves component c iteratively; true when it converged.
 	bool iterateComponent(int c, std::vector<Vector12>& solutions, int& iterations, int threadsFrom);
+	// solve's parts: the iterative path's components (iterated[c] set for
+	// those it solved, their unknowns added to `solved`, its statistics
+	// set); the refinement's iteration budget for component c from the
+	// factor `from`; a component factorised (with its kept analysis when it
+	// has one; `analysed` when that analysis was made now); and the factors
+	// made now kept to precondition the attempt's later solves.
+	void iterateLargeComponents(std::vector<Vector12>& solutions, int threadsFrom, std::vector<char>& iterated,
+	                            long& solved);
+	long refineBudget(int c, const Analysis& from) const;
+	bool factorComponent(int c, std::vector<Vector12>& solutions, bool& analysed);
+	void keepFactors(const std::vector<char>& factored);
 };
 
 }  // namespace dda

@@ -82,6 +82,10 @@ void World::accountStep(const IntegratorSettings& settings, double dt) {
 			energy_.loads += stiffness * (point.anchor - point.position - gamma * u).dot(u);
 		}
 	}
+	accountContacts();
+}
+
+void World::accountContacts() {
 	// Contacts: their springs' energy at the start of this step in the
 	// accepted states against what the last step ended with. Each contact's
 	// terms are computed on any thread, then summed in contact order.

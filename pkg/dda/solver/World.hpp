@@ -173,6 +173,9 @@ private:
 	// changes to the account (energy_), and records the springs' energy at its
 	// end; called before the contacts and blocks are moved (EnergyAccount.cpp).
 	void accountStep(const IntegratorSettings& settings, double dt);
+	// accountStep's contact part: contactChanges, the springs' energy, and
+	// the contacts' damping and friction.
+	void accountContacts();
 
 	std::unique_ptr<Collider> collider_ = std::make_unique<DESSCollider>();
 	ContactStore store_;
