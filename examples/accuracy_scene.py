@@ -34,7 +34,7 @@ or from Python (any YADE script or /usr/bin/python3):
 """
 import math
 
-from yade_dda import O, ddaBlock, DDAIntegrator, block
+from yade_dda import O, ddaBlock, DDAIntegrator, block, boxCorners
 from yade import wrapper
 
 G, PHI_DEG, V0 = 9.81, 30.0, 2.0
@@ -43,8 +43,7 @@ base = {'maxDisplacement': 0.01}
 _ids = {}
 
 
-def box(lo, hi):
-    return [(x, y, z) for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])]
+box = boxCorners   # the 8 corners of the box from lo to hi [m]
 
 
 def build():

@@ -18,8 +18,7 @@ start = time.time()
 rock = O.materials.append(PolyhedraMat(young=1e9, poisson=0.25, density=2600, frictionAngle=math.radians(30)))
 
 
-def box(lo, hi):
-    return [(x, y, z) for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])]
+box = boxCorners   # the 8 corners of the box from lo to hi [m]
 
 
 # 1. An L standing on a floor (foot [1,2] x [0,1] x [0,1], wall [0,1] x [0,1] x [0,2]) and a 0.5 m cube

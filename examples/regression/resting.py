@@ -64,8 +64,7 @@ else:
     regime = 'locked: laterally confined by the shear springs'
 
 
-def box(lo, hi):
-    return [(x, y, z) for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])]
+box = boxCorners   # the 8 corners of the box from lo to hi [m]
 
 
 rock = O.materials.append(PolyhedraMat(young=E, poisson=nu, density=rho, frictionAngle=phi))

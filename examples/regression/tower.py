@@ -41,8 +41,7 @@ from yade.params.table import *
 G = 9.81
 
 
-def box(lo, hi):
-    return [(x, y, z) for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])]
+box = boxCorners   # the 8 corners of the box from lo to hi [m]
 
 
 rock = O.materials.append(PolyhedraMat(young=1e10, poisson=0.25, density=2600, frictionAngle=math.radians(phiDeg)))
