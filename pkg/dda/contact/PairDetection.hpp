@@ -47,7 +47,7 @@
 //          of its own edges runs (within the angle tolerance), is measured
 //          against its own entrance face of R instead, as the corners Q
 //          below are: its gap is then positive (outsideBeyondFaceEdge,
-//          SubContacts.cpp: no overlap at a corner outside R to push on);
+//          FaceEntrance.cpp: no overlap at a corner outside R to push on);
 //          and so is a corner of I within d0 of F's plane that is not F's
 //          (its projection more than d0 from F, or deeper below the plane
 //          than the pair's penetration): a corner over a face of R beside
@@ -88,7 +88,7 @@
 //      largest separation: the point of either edge deepest inside the other
 //      block (the deeper of the two) against that point's own entrance face,
 //      a vertex-face stencil keyed as the two edges' edge-edge contact
-//      (nearParallelEdgeContact, SubContacts.cpp: two edges crossing at an
+//      (nearParallelEdgeContact, ParallelEdges.cpp: two edges crossing at an
 //      angle below the tolerance with the ends of both outside the other
 //      block overlap at no corner, and have no crossing contact).
 //      An edge entrance gives its edge-edge sub-contact (block i = A), or
@@ -110,7 +110,7 @@
 //      within 60 degrees of that face's, no deeper than the bound, not
 //      beside a vertex contact or the entrance crossing): the second point
 //      of an edge lying across a face, which the best face finds only when
-//      it is that face (crossingsAcrossEntranceFaces, SubContacts.cpp).
+//      it is that face (crossingsAcrossEntranceFaces, EdgeEntrance.cpp).
 //      Edge-edge stencils take as reference direction (from block i
 //      towards block j) the sum of the outward normals of the faces at i's
 //      edge minus that at j's edge.
@@ -225,7 +225,7 @@ struct EntranceFeature {
 	}
 };
 
-// The pair's near-parallel edge contact of the last step (SubContacts.cpp,
+// The pair's near-parallel edge contact of the last step (ParallelEdges.cpp,
 // nearParallelEdgeContact): the edge its point lies on (of block A when onA,
 // else of B), the other block's edge, and where that point ended the step
 // [m]. edge = -1: none.

@@ -3,7 +3,7 @@
 // the other block's corners on an entrance face, the face's own corners near
 // the other block, edges crossing the face's edges, an edge entrance's
 // crossing and what the best face finds away from it. No sub-contact is
-// deeper than the pair's penetration (SubContacts.cpp gives the rule).
+// deeper than the pair's penetration (SubContactRules.hpp gives the rule).
 // Units: m.
 #pragma once
 

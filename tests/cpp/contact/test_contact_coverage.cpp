@@ -225,7 +225,7 @@ struct Coverage {
 	// inside it (farther than the corner merge distance from its ends), lies
 	// inside the other part by more than the tolerance while no sub-contact
 	// of negative gap has a point within d0 of it. The overlap there has no
-	// spring of its own: nearParallelEdgeContact (SubContacts.cpp) acts only
+	// spring of its own: nearParallelEdgeContact (ParallelEdges.cpp) acts only
 	// when no sub-contact of the pair is negative, and a push elsewhere lets
 	// the blocks turn about it. Printed, not asserted.
 	long nearParallelBeside = 0;
@@ -566,7 +566,7 @@ TEST(ContactCoverage, CornersInsideAnotherBlockHaveContacts) {
 				// parallel within the angle tolerance allow (b1), and every one a
 				// corner whose edge runs along the edge of the face it lies past
 				// (it stands for the near-parallel edges' contact, which has no
-				// crossing; outsideBeyondFaceEdge, SubContacts.cpp). Before: the
+				// crossing; outsideBeyondFaceEdge, FaceEntrance.cpp). Before: the
 				// roofs' -9.2 cm gap 3.2 cm outside (seed 3, E 1e8) and 19 more
 				// deeper than the overlap through the axes of internal faces'
 				// edges (b2), and 4 corners past a face's edge at a real angle
@@ -575,7 +575,7 @@ TEST(ContactCoverage, CornersInsideAnotherBlockHaveContacts) {
 				                                                    << c.deepestBeyondWhere;
 				EXPECT_EQ(c.ghostsAcrossEdge, 0) << name << " seed " << seed << ": " << c.deepestAcrossWhere;
 				// Every overlapping pair has a contact pushing it apart. Before
-				// nearParallelEdgeContact (SubContacts.cpp): convex pile seed 6,
+				// nearParallelEdgeContact (ParallelEdges.cpp): convex pile seed 6,
 				// parts 18 and 19, edges crossing 0.001 to 0.04 rad from parallel
 				// with both ends outside the other part, 8 instances at E 1e8 (to
 				// 3.5 mm) and 3 at E 1e10 (to 6.4 mm, then a crossing appeared

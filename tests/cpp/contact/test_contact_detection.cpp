@@ -160,7 +160,7 @@ void checkInvariants(const PairContacts& r, const Block& a, const Block& b, cons
 		// parallel within the angle tolerance that overlap with no other
 		// contact, keyed as their edge-edge contact, measured as the point of
 		// edge 1 deepest inside block j against that point's own entrance face
-		// (SubContacts.cpp, nearParallelEdgeContact).
+		// (ParallelEdges.cpp, nearParallelEdgeContact).
 		const bool nearParallel = c.kind == ContactKind::EdgeEdge && c.stencil.kind == ContactKind::VertexFace;
 		if (!nearParallel) EXPECT_EQ(c.kind, c.stencil.kind);
 		const dda::LinearizedDistance lin = dda::linearizeNormalDistance(c.stencil, bi.centroid, bj.centroid);
@@ -1289,7 +1289,7 @@ TEST(ContactDetection, InternalEdgesBoundThePenetrationOfAPartAcrossItsRidge) {
 // crossings carry -delta; no corner outside the cube has a negative gap.
 // With its edges turned 0.01 rad from the cube's (within the angle
 // tolerance) P stands for the near-parallel edges' contact and keeps -delta
-// on the top face (outsideBeyondFaceEdge, SubContacts.cpp). Before, P took
+// on the top face (outsideBeyondFaceEdge, FaceEntrance.cpp). Before, P took
 // -delta on the top face's plane whatever theta, up to d0 past the edge.
 TEST(ContactDetection, CornerPastAFaceEdgeOutsideTheBlockHasNoNegativeGap) {
 	const Block cube = box(Vector3(0, 0, 0), Vector3(1, 1, 1));

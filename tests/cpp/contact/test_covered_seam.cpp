@@ -1,4 +1,4 @@
-// A corner at the seam of two flush fixed blocks (SubContacts.cpp,
+// A corner at the seam of two flush fixed blocks (OwnEntrance.cpp,
 // insideCoveredSeam in ownEntranceContact), in closed form.
 //
 // The placement: a fixed floor N, [-1.5, 1.5] x [-1, 1.5] x [-h, 0], and a

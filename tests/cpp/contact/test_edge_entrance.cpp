@@ -1,5 +1,5 @@
 // An edge entrance whose edge runs on across a face at the other entrance
-// edge (SubContacts.cpp, crossingsAcrossEntranceFaces), in closed form: the
+// edge (EdgeEntrance.cpp, crossingsAcrossEntranceFaces), in closed form: the
 // second crossing of that edge with the face's boundary is a sub-contact of
 // the pair while it is within d0, with the two lines' distance as its gap.
 //

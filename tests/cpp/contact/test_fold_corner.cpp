@@ -1,5 +1,5 @@
 // A corner of the entering block over a face beside the entrance face
-// (SubContacts.cpp, faceEntranceContacts: corners within d0 of the entrance
+// (FaceEntrance.cpp, faceEntranceContacts: corners within d0 of the entrance
 // face's plane but outside its projection window, measured against their own
 // entrance face), in closed form: the corner has a vertex-face contact with
 // that face, its distance from the face's plane as the gap, while within d0.

@@ -1,6 +1,6 @@
 // The fold rule's symmetric case in closed form: a corner of the block that
 // owns the entrance face, not on that face, over a face of the other block
-// (SubContacts.cpp, faceEntranceContacts). The corner has a vertex-face
+// (FaceEntrance.cpp, faceEntranceContacts). The corner has a vertex-face
 // contact with that face, its distance from the block as the gap, while
 // within d0.
 //

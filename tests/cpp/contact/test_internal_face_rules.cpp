@@ -3,12 +3,12 @@
 // BlockGeometry::internalFaces), each in a closed-form placement where that
 // rule alone decides the pair's sub-contacts: the pair overlaps by a known
 // depth e, so the depth bound (no sub-contact deeper than the pair's
-// penetration, SubContacts.cpp) keeps every sub-contact the rule is about.
+// penetration, OwnEntrance.cpp) keeps every sub-contact the rule is about.
 //   - A face facing an internal face of the other block is no entrance
 //     (facesInternal, SeparatingAxes.cpp): a cube on the seam of a two-part
 //     slab.
 //   - A corner more than d0 across an internal face gets no contact from the
-//     block (ownEntranceContact, SubContacts.cpp): a slab over the ridge of a
+//     block (ownEntranceContact, OwnEntrance.cpp): a slab over the ridge of a
 //     wedge-shaped part whose sloping face is covered.
 //   - A corner beyond two internal faces and beyond the exposed face's
 //     polygon gets no contact (the ridge rule of ownEntranceContact): a slab

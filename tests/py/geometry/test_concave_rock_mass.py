@@ -162,7 +162,7 @@ def test_a_tunnel_in_concave_blocks_keeps_its_account_and_its_loose_block_falls_
     # What detection gives the springs stays within 1e-4 of the largest change. The bursts it had came from
     # corners given a negative gap against a face whose plane runs on past a ridge of a concave block,
     # the corners outside the whole block: 78 J in one step (refineSolves off; +114 J over the run on an
-    # older solver), until ownEntranceContact bounded those gaps by the pair's penetration (SubContacts.cpp).
+    # older solver), until ownEntranceContact bounded those gaps by the pair's penetration (OwnEntrance.cpp).
     # Now -74 J of 2.3e5 (energy lost; -37 J with refineSolves off, no step above 1 J).
     changes = e['contactChanges'] - e0['contactChanges']
     print('contact changes %.4g J, largest change %.4g J' % (changes, scale))

@@ -378,7 +378,7 @@ def test_a_jointed_cube_of_free_blocks_starts_at_rest(scene):
     """A 16 m cube cut by three oblique sets (293 blocks), those on the faces x = 0, x = 16 and z = 0 held
     and 181 free: the first step finds no contact deeper than 1 mm. It found contacts 2 to 4 m deep: a free
     block's corner touching a fixed block only where that block's faces are flush with fixed neighbours
-    (internal) was measured against its one outer face, across the block (pkg/dda/contact/SubContacts.cpp,
+    (internal) was measured against its one outer face, across the block (pkg/dda/contact/OwnEntrance.cpp,
     ownEntranceContact)."""
     side = 16.0
     sets = [dict(dip=60, dipDirection=80, spacing=2.0, origin=(0.4, 0.3, 0.2)),

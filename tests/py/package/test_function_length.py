@@ -1,4 +1,4 @@
-"""No function in the C++ core is longer than a reader can hold.
+"""No function or file in the C++ core is longer than a reader can hold.
 
 LIMIT below is the one definition of the bound: no function body in pkg/
 (C++ sources and headers, the binding included) spans more than LIMIT lines,
@@ -11,13 +11,17 @@ string and character literals are blanked out: a `{` at namespace or class
 scope whose head (the text since the last `;`, `{` or `}`) holds a `)` and is
 no aggregate initialiser is a function body, and everything up to its matching
 `}` (lambdas and local classes included) belongs to that function.
+
+FILE_LIMIT bounds a source file's lines the same way (one concern per file:
+a longer one is split by the rules it holds).
 """
 import os
 import re
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
 PKG = os.path.join(REPO, 'pkg')
-LIMIT = 120
+LIMIT = 80
+FILE_LIMIT = 600
 SOURCE_SUFFIXES = ('.hpp', '.cpp', '.h', '.cc')
 
 _SCOPE = re.compile(r'((inline|export)\s+)*(namespace|class|struct|union|enum)\b|extern\b')
@@ -156,6 +160,20 @@ def long_functions(pkg, limit=LIMIT):
 def test_no_function_in_the_core_is_longer_than_the_limit():
     found = long_functions(PKG)
     assert not found, 'functions over %d lines (split them):\n' % LIMIT + '\n'.join(found)
+
+
+def test_no_file_in_the_core_is_longer_than_the_limit():
+    long_files = []
+    for root, _, names in os.walk(PKG):
+        for name in sorted(names):
+            if name.endswith(SOURCE_SUFFIXES):
+                path = os.path.join(root, name)
+                with open(path, encoding='utf-8') as f:
+                    lines = sum(1 for _ in f)
+                if lines > FILE_LIMIT:
+                    long_files.append('%s: %d lines' % (os.path.relpath(path, PKG), lines))
+    assert not long_files, 'files over %d lines (split them by the rules they hold):\n' % FILE_LIMIT + \
+        '\n'.join(long_files)
 
 
 def test_the_measure_counts_what_ctags_counts():
