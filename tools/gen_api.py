@@ -585,19 +585,9 @@ def main():
     text = render()
     if render.undocumented:
         print('no docstring: %s' % ', '.join(render.undocumented), file=sys.stderr)
-    with open(TARGET) if os.path.exists(TARGET) else open(os.devnull) as f:
-        current = f.read()
-    if args.check:
-        if current != text:
-            print('%s is stale: run make docs' % os.path.relpath(TARGET, REPO))
-            sys.exit(1)
-        return
-    if current != text:
-        with open(TARGET, 'w') as f:
-            f.write(text)
-        print('wrote %s' % os.path.relpath(TARGET, REPO))
-    else:
-        print('%s is up to date' % os.path.relpath(TARGET, REPO))
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from docpage import writeOrCheck
+    writeOrCheck(TARGET, text, args.check, REPO)
 
 
 if __name__ == '__main__':

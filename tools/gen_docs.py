@@ -57,19 +57,9 @@ def main():
     if os.environ.get('YADE_DDA_BUILD'):
         sys.path.insert(0, os.environ['YADE_DDA_BUILD'])
     text = render()
-    with open(TARGET) if os.path.exists(TARGET) else open(os.devnull) as f:
-        current = f.read()
-    if args.check:
-        if current != text:
-            print('%s is stale: run make docs' % os.path.relpath(TARGET, REPO))
-            sys.exit(1)
-        return
-    if current != text:
-        with open(TARGET, 'w') as f:
-            f.write(text)
-        print('wrote %s' % os.path.relpath(TARGET, REPO))
-    else:
-        print('%s is up to date' % os.path.relpath(TARGET, REPO))
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from docpage import writeOrCheck
+    writeOrCheck(TARGET, text, args.check, REPO)
 
 
 if __name__ == '__main__':
