@@ -244,6 +244,9 @@ def restoreState():
     scene.bodyOfBlock = list(bodies)
     scene.clumpMembers = {clumpId: tuple(bodies[index:index + core.partCount(index)])
                           for index, clumpId in core.clumps()}
+    for index, clumpId in core.clumps():
+        if core.isFixed(index) and O.bodies[clumpId] is not None:
+            O.bodies[clumpId].dynamic = False   # as _addConcave makes it (a file saved before it did)
     scene.cover = tuple(info['cover']) if info.get('cover') is not None else None
     # The blocks the saved scene had already checked for initial overlaps (guards.checkInitialOverlaps)
     # stay checked: checked again, blocks pressed into each other by their contacts (an impact, a block

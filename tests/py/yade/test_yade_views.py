@@ -293,6 +293,25 @@ def test_unbalanced_force_falls_beside_a_fixed_concave_block():
     assert hooks.unbalancedForce._yadeDDA() == pytest.approx(utils.unbalancedForce(), rel=1e-12)
 
 
+def test_a_loaded_fixed_concave_block_is_not_dynamic(tmp_path):
+    """A file whose fixed concave block's clump is dynamic (saved before clumps of fixed blocks were
+    made static) loads with the clump static, so unbalancedForce falls there too."""
+    rock = material(O, young=1e8)
+    O.bodies.append(yade_dda.ddaBlock(box((-3, -3, -1), (3, 3, 0)), material=rock, fixed=True))
+    parts = [box((1.2, 0, 0), (2.2, 1, 1)), box((1.2, 1, 0), (2.2, 2, 1))]
+    clump, _ = O.bodies.appendClumped(yade_dda.concaveBlock(parts, material=rock, fixed=True))
+    O.bodies.append(yade_dda.ddaBlock(box((0, 0, 0), (1, 1, 1)), material=rock))
+    O.engines = [yade_dda.DDAIntegrator(dt=1e-3, gravity=(0, 0, -G))]
+    O.run(200, True)
+    O.bodies[clump].dynamic = True   # as such a file has it
+    path = str(tmp_path / 'old.yade')
+    O.save(path)
+    O.load(path)
+    assert not O.bodies[clump].dynamic
+    O.run(100, True)
+    assert utils.unbalancedForce() < 0.05
+
+
 def test_a_dda_step_leaves_yades_thread_count_alone():
     """A DDA step with threads=1 taken by O.step() (in the calling thread) once left OpenMP's thread
     count at 1 there; O.reset() then made a scene whose ForceContainer YADE sized for one thread, and
