@@ -18,7 +18,7 @@ import time
 from ._yade import O, utils, wrapper
 from . import colliders as _colliders
 from . import params as _settings
-from .params import finite
+from .params import finite, isPoint
 from .blocks import concaveBlock, ddaBlock
 from .engines import DDAIntegrator
 from . import scene as _scene
@@ -31,18 +31,11 @@ DEFAULT_OUT = os.path.join('bench', 'out', 'compare_colliders.json')
 _POLYHEDRA_LOGGER = 'Polyhedra_support.cpp'   # YADE's logger of its polyhedron intersection
 
 
-def _isPoint(p):
-    try:
-        return len(p) == 3 and all(isinstance(float(x), float) for x in p)
-    except (TypeError, ValueError):
-        return False
-
-
 def _parts(shape, i):
     """[points] of a convex block (a list of points) or [[points], ...] of a concave one (a list of convex
     parts, each a list of points), as float tuples."""
     shape = list(shape)
-    nested = bool(shape) and not _isPoint(shape[0])
+    nested = bool(shape) and not isPoint(shape[0])
     try:
         parts = [list(part) for part in shape] if nested else [shape]
         return [[tuple(float(x) for x in p) for p in part] for part in parts]
@@ -63,7 +56,7 @@ def _blockList(blocks):
     for i, entry in enumerate(blocks):
         entry = list(entry)
         if len(entry) == 2 and isinstance(entry[1], (bool, int)) and not isinstance(entry[0], (int, float)) \
-                and not _isPoint(entry[0]):
+                and not isPoint(entry[0]):
             shape, fixed = entry[0], bool(entry[1])
         else:
             shape, fixed = entry, False

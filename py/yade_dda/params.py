@@ -11,6 +11,7 @@ package may import it (doc/DESIGN.md, "The Python package").
 """
 import difflib
 import math
+import numbers
 import os
 
 from . import _core
@@ -37,6 +38,14 @@ def finite(name, value, low=None, high=None, lowOpen=False, unit='', highOpen=Fa
                                    if high is not None else 'inf)')
         raise ValueError('%s must be finite and in %s, got %r%s' % (name, bounds, value, unit))
     return value
+
+
+def isPoint(p):
+    """True for a sequence of 3 real numbers (bool excluded): a point [m], as opposed to a list of points."""
+    try:
+        return len(p) == 3 and all(isinstance(x, numbers.Real) and not isinstance(x, bool) for x in p)
+    except TypeError:
+        return False
 
 
 def vector(value, what, length=3):

@@ -13,6 +13,7 @@ import numbers
 from . import _core
 from ._yade import O
 from .blocks import ddaBlock, concaveBlock
+from .params import isPoint
 
 _SET_KEYS = ('dip', 'dipDirection', 'spacing', 'origin', 'persistence', 'fisherK', 'spacingDistribution',
              'spacingStd')
@@ -220,13 +221,6 @@ def _point(p, what):
     return tuple(_number(x, what) for x in items)
 
 
-def _isPoint(p):
-    try:
-        return len(p) == 3 and all(isinstance(x, numbers.Real) and not isinstance(x, bool) for x in p)
-    except TypeError:
-        return False
-
-
 def _parts(domain):
     """The domain as a list of convex corner lists, each point checked."""
     try:
@@ -235,7 +229,7 @@ def _parts(domain):
         raise ValueError('domain must be a convex corner list or a list of convex parts, got %r' % (domain,)) from None
     if not items:
         raise ValueError('domain is empty: give a convex corner list or a list of convex parts')
-    parts = [items] if _isPoint(items[0]) else items
+    parts = [items] if isPoint(items[0]) else items
     checked = []
     for i, part in enumerate(parts):
         try:
@@ -329,13 +323,13 @@ def _joint(entry, i):
             items = list(entry['excavate'])
         except TypeError:
             items = []
-        if len(items) == 2 and all(_isPoint(p) for p in items):      # (point, normal): a half-space
+        if len(items) == 2 and all(isPoint(p) for p in items):      # (point, normal): a half-space
             point, normal = _pointNormal(items, where, 'excavate')
             return dict(kind='excavate', point=point, normal=normal)
         if not items:
             raise ValueError('%s: excavate must be (point, normal), a convex corner list or a list of them, got %r'
                              % (where, entry['excavate']))
-        regions = [items] if _isPoint(items[0]) else items
+        regions = [items] if isPoint(items[0]) else items
         return dict(kind='excavateRegion', regions=[_region(region, where, r) for r, region in enumerate(regions)])
     if 'plane' in entry:
         _unknownKeys(entry, _PLANE_KEYS, where)

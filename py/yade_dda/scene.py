@@ -411,15 +411,15 @@ def _blockCount(scene, parts):
 
 
 def _effects(s):
-    """Which effects the last step simulated, from its counters (see stats())."""
+    """Which effects the last step simulated, from its counters (each key's meaning: _PYTHON_STATS)."""
     return {
-        'friction': s['frictionContacts'] > 0,          # some contact has a friction angle > 0
-        'gravity': s['bodyForceBlocks'] > 0,            # a body force was assembled
-        'static': bool(s['staticAnalysis']),            # velocityRatio == 0
-        'bonds': s['bondedContacts'] > 0,               # some contact is a bonded joint
-        'fixedBlocks': s['fixedBlocks'],                # blocks without unknowns (never paired together)
-        'restingReuse': bool(s['broadPhaseSkipped']),   # broad phase served from the pair cache
-        'rigidBlocks': s['rigidBlocks'],                # blocks with 6 unknowns
+        'friction': s['frictionContacts'] > 0,
+        'gravity': s['bodyForceBlocks'] > 0,
+        'static': bool(s['staticAnalysis']),
+        'bonds': s['bondedContacts'] > 0,
+        'fixedBlocks': s['fixedBlocks'],
+        'restingReuse': bool(s['broadPhaseSkipped']),
+        'rigidBlocks': s['rigidBlocks'],
     }
 
 

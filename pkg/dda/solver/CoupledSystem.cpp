@@ -466,19 +466,19 @@ long CoupledSystem::refineBudget(int c, const Analysis& from) const {
 	return std::min<long>(kMaxRefineIterations, 6 * from.cholesky.factorProducts() / perIteration);
 }
 
-bool CoupledSystem::factorComponent(int c, std::vector<Vector12>& solutions, bool& analysed) {
+bool CoupledSystem::factorComponent(int c, std::vector<Vector12>& solutions, Factorisation& how) {
 	Analysis* analysis = componentAnalysis_.empty() ? nullptr : componentAnalysis_[c];
-	analysed = false;
 	if (!analysis) {
+		how = Factorisation::Own;
 		BlockCholesky cholesky;
 		return solveComponent(c, cholesky, true, solutions);
 	}
 	const bool analyse = !analysis->analysed;
+	how = analyse ? Factorisation::NewAnalysis : Factorisation::KeptAnalysis;
 	const bool solvedHere = solveComponent(c, analysis->cholesky, analyse, solutions);
 	if (analyse) {
 		analysis->analysed = true;
 		analysis->bytes = analysis->cholesky.memoryBytes();
-		analysed = true;
 	}
 	return solvedHere;
 }
@@ -542,11 +542,11 @@ void CoupledSystem::solve(std::vector<Vector12>& solutions, int threadsFrom) {
 				++fallbacks;
 			}
 		}
-		bool analysed = false;
-		const bool solvedHere = factorComponent(c, solutions, analysed);
-		if (!componentAnalysis_.empty() && componentAnalysis_[c]) {
+		Factorisation how = Factorisation::Own;
+		const bool solvedHere = factorComponent(c, solutions, how);
+		if (how != Factorisation::Own) {
 			factored[c] = 1;
-			++(analysed ? newAnalyses : reusedAnalyses);
+			++(how == Factorisation::NewAnalysis ? newAnalyses : reusedAnalyses);
 		}
 		if (!solvedHere) {
 #pragma omp atomic write

@@ -230,13 +230,14 @@ private:
 	// solve's parts: the iterative path's components (iterated[c] set for
 	// those it solved, their unknowns added to `solved`, its statistics
 	// set); the refinement's iteration budget for component c from the
-	// factor `from`; a component factorised (with its kept analysis when it
-	// has one; `analysed` when that analysis was made now); and the factors
-	// made now kept to precondition the attempt's later solves.
+	// factor `from`; a component factorised (`how`: with its kept analysis,
+	// made now or earlier, or with a factorisation of its own); and the
+	// factors made now kept to precondition the attempt's later solves.
 	void iterateLargeComponents(std::vector<Vector12>& solutions, int threadsFrom, std::vector<char>& iterated,
 	                            long& solved);
 	long refineBudget(int c, const Analysis& from) const;
-	bool factorComponent(int c, std::vector<Vector12>& solutions, bool& analysed);
+	enum class Factorisation { Own, NewAnalysis, KeptAnalysis };
+	bool factorComponent(int c, std::vector<Vector12>& solutions, Factorisation& how);
 	void keepFactors(const std::vector<char>& factored);
 };
 
