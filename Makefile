@@ -99,7 +99,7 @@ regress-run:
 	$(PYTHON) examples/regression/check.py examples/regression/$(TABLE).table $(abspath $(REGRESS_OUT))/$(TABLE) $(CHECK_ARGS)
 
 # Sweeps on a cluster (doc/guide/how-to.md, "Sweeps on a cluster"): every row of a yade-batch table as its own
-# YADE process on Dask distributed (python3 -m yade_dda.sweep), with the build tree's yade_dda; a local
+# YADE process on Dask distributed (python3 -m yade_dda.tools.sweep), with the build tree's yade_dda; a local
 # cluster of JOBS single-threaded workers unless SWEEP_ARGS says otherwise (--scheduler tcp://HOST:8786,
 # --workers N, --timeout S). TABLE is a path or the name of a table in examples/regression (default quick).
 # Records and logs go to $(SWEEP_OUT)/<table>; a table of examples/regression is then checked by check.py.
@@ -108,7 +108,7 @@ SWEEP_ARGS ?= --workers $(JOBS)
 sweep: build
 	@table=$(TABLE); [ -f "$$table" ] || table=examples/regression/$(TABLE).table; \
 	out=$(abspath $(SWEEP_OUT))/$$(basename $$table .table); mkdir -p $$out; \
-	{ PYTHONPATH=$(abspath $(BUILD))/py $(PYTHON) -m yade_dda.sweep $$table --out $$out $(SWEEP_ARGS) 2>&1; \
+	{ PYTHONPATH=$(abspath $(BUILD))/py $(PYTHON) -m yade_dda.tools.sweep $$table --out $$out $(SWEEP_ARGS) 2>&1; \
 	  echo $$? > $$out/sweep.status; } | grep --line-buffered -v '^Using python version' | tee $$out/sweep.log; \
 	status=$$(cat $$out/sweep.status); \
 	if [ "$$(cd $$(dirname $$table) && pwd)" = "$(abspath examples/regression)" ]; then \

@@ -45,7 +45,7 @@ optimal points filled). Run: make bench, or
 (YADE_DDA_BUILD=<build>/py to use a build tree instead of the installed package).
 
 Your own scene: a script defining build(), measure() (the error, a float or a dict
-with 'error') and tEnd [s] (see yade_dda.accuracy):
+with 'error') and tEnd [s] (see yade_dda.tools.accuracy):
   /usr/bin/python3 bench/accuracy.py --scene my_scene.py --knob dt=1e-2,1e-3,1e-4
 """
 import argparse
@@ -123,7 +123,7 @@ class Scene:
         return self._measure(self.context)
 
     def monitor(self):
-        """A per-step callable for yade_dda.accuracy.runPoint (None when the scene has none): it makes
+        """A per-step callable for yade_dda.tools.accuracy.runPoint (None when the scene has none): it makes
         the scene's monitor in `context` at the first step after build() and calls it every step."""
         if self.monitorFactory is None:
             return None
@@ -448,7 +448,7 @@ def yadeIncline(phiDeg, fraction, tEnd, diagnose=False):
 
 def runKnob(knob, values, sceneNames, base, tEnd, log=print):
     """Sweeps one knob over the named scenes in this process; returns {scene: [points]}."""
-    from yade_dda import accuracy
+    from yade_dda.tools import accuracy
     out = {}
     for name in sceneNames:
         scene = SCENES[name]()
@@ -503,7 +503,7 @@ def worker(task):
 
 def runCustom(script, knob, values):
     """A user's scene: the script defines build(), measure() and tEnd."""
-    from yade_dda import accuracy
+    from yade_dda.tools import accuracy
     namespace = runpy.run_path(script, run_name='accuracy_scene')
     for name in ('build', 'measure', 'tEnd'):
         if name not in namespace:
@@ -564,7 +564,7 @@ def plots(result, outDir):
     matplotlib.use('Agg')
     from matplotlib.figure import Figure
     from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from yade_dda.accuracy import paretoFront
+    from yade_dda.tools.accuracy import paretoFront
     files = []
     floor = 1e-16
     for knob, scenes in result['knobs'].items():

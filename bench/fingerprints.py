@@ -74,7 +74,7 @@ def _worker(kind, spec, paperSteps):
             perStep.append(contactHash())
 
     if kind == 'regression':
-        from yade_dda import regression
+        from yade_dda.tools import regression
         table, line = spec.rsplit(':', 1)
         os.environ['YADE_BATCH'] = spec
         os.environ.setdefault('YADE_DDA_RECORDS', os.path.join('/tmp', 'yade-dda-fingerprint-records'))

@@ -30,7 +30,7 @@ Sweep it:
 or from Python (any YADE script or /usr/bin/python3):
     import yade_dda, runpy
     s = runpy.run_path('examples/accuracy_scene.py')
-    points = yade_dda.accuracy.sweep(s['build'], s['measure'], 'dt', [1e-2, 1e-3], tEnd=s['tEnd'])
+    points = yade_dda.accuracySweep(s['build'], s['measure'], 'dt', [1e-2, 1e-3], tEnd=s['tEnd'])
 """
 import math
 

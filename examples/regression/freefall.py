@@ -15,7 +15,7 @@ Parameters (table columns): dt [s] largest time step, tEnd [s] simulated time.
 Run alone: yade -n -x freefall.py
 """
 from yade_dda import *
-from yade_dda import regression
+from yade_dda.tools import regression
 from yade import PolyhedraMat
 
 regression.readParamsFromTable(dt=1e-3, tEnd=1.0)

@@ -33,7 +33,7 @@ Run alone: yade -n -x incline.py
 import math
 
 from yade_dda import *
-from yade_dda import regression
+from yade_dda.tools import regression
 from yade import PolyhedraMat
 
 regression.readParamsFromTable(slopeDeg=30.0, phiDeg=20.0, dt=1e-3, tEnd=1.0, collider='DESS')

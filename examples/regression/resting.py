@@ -33,7 +33,7 @@ Run alone: yade -n -x resting.py
 import math
 
 from yade_dda import *
-from yade_dda import regression
+from yade_dda.tools import regression
 from yade import PolyhedraMat
 
 regression.readParamsFromTable(phiDeg=30.0, dt=2e-3, tEnd=0.5, collider='DESS')

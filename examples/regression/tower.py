@@ -32,7 +32,7 @@ simulated time; collider. Run alone: yade -n -x tower.py
 import math
 
 from yade_dda import *
-from yade_dda import regression
+from yade_dda.tools import regression
 from yade import PolyhedraMat
 
 regression.readParamsFromTable(phiDeg=30.0, dt=2e-3, tEnd=1.0, collider='DESS')

@@ -27,7 +27,7 @@ collider. Run alone: yade -n -x wedge.py
 import math
 
 from yade_dda import *
-from yade_dda import regression
+from yade_dda.tools import regression
 from yade import PolyhedraMat
 
 regression.readParamsFromTable(fs=0.7, slopeDeg=35.0, dt=2e-3, tEnd=1.0, collider='DESS')

@@ -11,12 +11,16 @@ advanced by Shi's implicit time scheme. A script reads like any YADE script::
 
 All quantities are SI: metres, seconds, kilograms, pascals, newtons, radians.
 
-``from yade_dda import *`` gives what a scene script uses (``__all__``). The
-bench tools stay out of it and load when first asked for:
-``yade_dda.compareColliders`` (yade_dda.compare), ``yade_dda.accuracySweep``
-(``yade_dda.accuracy.sweep``), ``from yade_dda import regression`` and the
-module ``yade_dda.sweep`` (``python3 -m yade_dda.sweep``: a yade-batch table
-on Dask distributed).
+``from yade_dda import *`` gives what a scene script uses (``__all__``); the
+modules of the package are that scene API. The workflow tools are the
+subpackage ``yade_dda.tools``, which ``import yade_dda`` does not load:
+``yade_dda.tools.compare`` (``compareColliders``: every collider on one set of
+blocks), ``yade_dda.tools.accuracy`` (``sweep``: accuracy against time),
+``yade_dda.tools.regression`` (records of yade-batch regression scenes) and
+``yade_dda.tools.sweep`` (``python3 -m yade_dda.tools.sweep``: a yade-batch
+table on Dask distributed). Two of them are also names of the package, loaded
+when first asked for and out of ``import *``: ``yade_dda.compareColliders``
+and ``yade_dda.accuracySweep`` (``yade_dda.tools.accuracy.sweep``).
 """
 from ._yade import O
 from ._core import __version__  # noqa: F401  (CMakeLists.txt's project version)
@@ -40,24 +44,16 @@ __all__ = ['ddaBlock', 'rigidBlock', 'concaveBlock', 'boxCorners', 'cutRockMass'
            'Checkpoint', 'latestCheckpoint', 'DDAVTKRecorder', 'stats', 'printStats', 'sync', 'block', 'blockOf',
            'setVelocity', 'addPointLoad', 'addFixedPoint', 'contacts', 'Ig2_DDABlock_DDABlock_DDAContact', 'O']
 
-_TOOLS = ('compare', 'accuracy', 'regression', 'compareColliders', 'accuracySweep', 'sweep')
-"""Bench tools: attributes of the package, loaded on first use, out of ``import *``."""
+_TOOLS = ('compareColliders', 'accuracySweep')
+"""Tools of yade_dda.tools that are also names of the package: loaded on first use, out of ``import *``."""
 
 
 def __getattr__(name):
-    """Loads a bench tool (see _TOOLS) on first use (PEP 562). (Importing a
-    submodule makes it an attribute of the package; ``from . import compare``
-    would ask this function again.)"""
-    if name in ('compare', 'compareColliders'):
-        from .compare import compareColliders
-        return compareColliders if name == 'compareColliders' else globals()['compare']
-    if name in ('accuracy', 'accuracySweep'):
-        from .accuracy import sweep
-        return sweep if name == 'accuracySweep' else globals()['accuracy']
-    if name == 'regression':
-        from .regression import versions  # noqa: F401
-        return globals()['regression']
-    if name == 'sweep':
-        from .sweep import runRows  # noqa: F401
-        return globals()['sweep']
+    """Loads a tool named in _TOOLS from yade_dda.tools on first use (PEP 562)."""
+    if name == 'compareColliders':
+        from .tools.compare import compareColliders
+        return compareColliders
+    if name == 'accuracySweep':
+        from .tools.accuracy import sweep
+        return sweep
     raise AttributeError('module %r has no attribute %r' % (__name__, name))

@@ -1,4 +1,4 @@
-"""Accuracy against time (bench/accuracy.py, yade_dda.accuracy.sweep): the quick dt sweep of
+"""Accuracy against time (bench/accuracy.py, yade_dda.tools.accuracy.sweep): the quick dt sweep of
 the benchmark and the sweep API.
 
 - `bench/accuracy.py --quick --knobs dt` on the free fall, the frictional
@@ -14,7 +14,7 @@ the benchmark and the sweep API.
   of: on core b7154a7 the quick run's wedge is off by 1.1e-4, 4.0e-4 and
   1.0e-3 of its slide at dt 1e-2, 3e-3 and 1e-3 s, the incline by 1.0e-4,
   4.8e-5 and 5.7e-5; doc/benchmarks.md, "What accuracy costs".)
-- `yade_dda.accuracy.sweep` in this process: points carry the knob value, error and
+- `yade_dda.tools.accuracy.sweep` in this process: points carry the knob value, error and
   cost; bad arguments raise ValueError naming the problem.
 
 About 15 s on the 2-core machine (two YADE start-ups, 0.3 s simulated per run).
@@ -29,6 +29,7 @@ import pytest
 
 import yade_dda
 from yade_dda import O, ddaBlock, DDAIntegrator, block
+from yade_dda.tools import accuracy
 from yade import wrapper
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
@@ -100,7 +101,7 @@ def _height():
 
 
 def test_sweep_api(scene):
-    points = yade_dda.accuracy.sweep(_throw, _height, 'dt', [2e-2, 5e-3], tEnd=0.1, base={'maxDisplacement': 0.5})
+    points = accuracy.sweep(_throw, _height, 'dt', [2e-2, 5e-3], tEnd=0.1, base={'maxDisplacement': 0.5})
     assert [p['value'] for p in points] == [2e-2, 5e-3]
     assert [p['steps'] for p in points] == [5, 20]
     for p in points:
@@ -110,14 +111,14 @@ def test_sweep_api(scene):
 
 def test_sweep_rejects_bad_arguments(scene):
     with pytest.raises(ValueError, match='unknown knob'):
-        yade_dda.accuracy.sweep(_throw, _height, 'timestep', [1e-3], tEnd=0.1)
+        accuracy.sweep(_throw, _height, 'timestep', [1e-3], tEnd=0.1)
     with pytest.raises(ValueError, match='tEnd'):
-        yade_dda.accuracy.sweep(_throw, _height, 'dt', [1e-3], tEnd=-1)
+        accuracy.sweep(_throw, _height, 'dt', [1e-3], tEnd=-1)
     with pytest.raises(ValueError, match='no values'):
-        yade_dda.accuracy.sweep(_throw, _height, 'dt', [], tEnd=0.1)
+        accuracy.sweep(_throw, _height, 'dt', [], tEnd=0.1)
     with pytest.raises(ValueError, match='dt must be'):
-        yade_dda.accuracy.sweep(_throw, _height, 'dt', [-1e-3], tEnd=0.1)
+        accuracy.sweep(_throw, _height, 'dt', [-1e-3], tEnd=0.1)
     with pytest.raises(ValueError, match='unknown knob'):
-        yade_dda.accuracy.sweep(_throw, _height, 'dt', [1e-3], tEnd=0.1, base={'dtMax': 1.0})
+        accuracy.sweep(_throw, _height, 'dt', [1e-3], tEnd=0.1, base={'dtMax': 1.0})
     with pytest.raises(ValueError, match="'error'"):
-        yade_dda.accuracy.sweep(_throw, lambda: {'e': 1.0}, 'dt', [1e-2], tEnd=0.02)
+        accuracy.sweep(_throw, lambda: {'e': 1.0}, 'dt', [1e-2], tEnd=0.02)

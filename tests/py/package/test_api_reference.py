@@ -1,6 +1,6 @@
 """doc/api.md, the reference of the public Python names, is what
 tools/gen_api.py makes of the docstrings now: not stale, a section for every
-name of yade_dda.__all__ and every bench tool, the same text on every run and
+name of yade_dda.__all__ and every workflow tool, the same text on every run and
 machine; and its Markdown rendering of a docstring keeps paragraphs, literals
 and example blocks."""
 import importlib.util
@@ -47,7 +47,7 @@ def test_every_public_name_has_a_section():
     headings = set(_headings(_page()))
     missing = [name for name in yade_dda.__all__ if '`%s`' % name not in headings]
     assert not missing, 'names of yade_dda.__all__ without a section in doc/api.md: %s' % ', '.join(missing)
-    for tool in ('compareColliders', 'accuracySweep', 'regression', 'python3 -m yade_dda.sweep',
+    for tool in ('compareColliders', 'accuracySweep', 'regression', 'python3 -m yade_dda.tools.sweep',
                  'regression.Record', 'regression.readParamsFromTable', 'regression.runTo'):
         assert '`%s`' % tool in headings, tool
 

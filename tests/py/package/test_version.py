@@ -3,7 +3,7 @@ import os
 import re
 
 import yade_dda
-from yade_dda import regression
+from yade_dda.tools import regression
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
 

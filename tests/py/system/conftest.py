@@ -2,8 +2,8 @@
 
 `batch`: one yade-batch run of examples/regression/quick.table plus a row that
 crashes on purpose, for the whole session: test_regression_batch.py checks
-it, test_sweep.py compares the records of `python3 -m yade_dda.sweep` with
-it. The jobs import the yade_dda this test process imports (the build tree
+it, test_sweep.py compares the records of `python3 -m yade_dda.tools.sweep`
+with it. The jobs import the yade_dda this test process imports (the build tree
 under YADE_DDA_BUILD, else the installed package).
 """
 import os

@@ -15,7 +15,8 @@ installed package); then check.py on the records:
 
 About 30 s on the 2-core machine (9 short scenes, two at a time; most of it
 is YADE's start-up per scene). The table reader of check.py and the table
-helper of yade_dda.regression are checked against YADE's own without a batch.
+helper of yade_dda.tools.regression are checked against YADE's own without a
+batch.
 """
 import importlib.util
 import json
@@ -27,7 +28,8 @@ import subprocess
 import pytest
 
 import yade_dda
-from yade_dda import O, regression
+from yade_dda import O
+from yade_dda.tools import regression
 from yade import utils
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))

@@ -1,6 +1,6 @@
-"""Sweeps on a cluster (doc/guide/how-to.md, "Sweeps on a cluster"): `python3 -m yade_dda.sweep` on Dask.
+"""Sweeps on a cluster (doc/guide/how-to.md, "Sweeps on a cluster"): `python3 -m yade_dda.tools.sweep` on Dask.
 
-- The quick table (`python3 -m yade_dda.sweep examples/regression/quick.table
+- The quick table (`python3 -m yade_dda.tools.sweep examples/regression/quick.table
   --workers 2 --out DIR`, a local cluster) passes check.py; the records and
   logs have yade-batch's file names, and each record says what the
   yade-batch run of the same row says (the session fixture `batch` of
@@ -37,14 +37,14 @@ REGRESSION = os.path.join(ROOT, 'examples', 'regression')
 CHECK = os.path.join(REGRESSION, 'check.py')
 QUICK = os.path.join(REGRESSION, 'quick.table')
 PYTHON = '/usr/bin/python3'
-SWEEP = [PYTHON, '-m', 'yade_dda.sweep']
+SWEEP = [PYTHON, '-m', 'yade_dda.tools.sweep']
 
 # A scene for the kill and the failure: with a marker path, its first attempt writes the marker
 # (its PID and its parent's, the worker's) and holds for holdSeconds; an attempt that finds the
 # marker records itself as attempt 2 at once. fail=1 raises; record=0 exits normally without a record.
 HOLD_SCENE = '''\
 import os, time
-from yade_dda import regression
+from yade_dda.tools import regression
 regression.readParamsFromTable(marker='', holdSeconds=0.0, fail=0, record=1)
 from yade.params.table import *
 if fail:

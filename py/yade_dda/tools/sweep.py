@@ -1,7 +1,7 @@
 """Sweeps on a cluster: every row of a yade-batch table as its own YADE process on Dask distributed.
 
-    /usr/bin/python3 -m yade_dda.sweep TABLE [--workers N | --scheduler ADDRESS] --out DIR
-                                       [--lines 2,5-7] [--scenes DIR] [--retries N] [--timeout S]
+    /usr/bin/python3 -m yade_dda.tools.sweep TABLE [--workers N | --scheduler ADDRESS] --out DIR
+                                             [--lines 2,5-7] [--scenes DIR] [--retries N] [--timeout S]
 
 Each row of TABLE (a yade-batch table: first line the column names, ``!SCRIPT``
 the scene of each row, ``description`` the name of its record) runs as
@@ -34,9 +34,9 @@ it runs past ``--timeout`` [s], or when its worker died more often than Dask
 allows; each failure is reported with the path and the last lines of its
 log, and the command exits 1 (0 when every row passed). A row that exits
 normally is done, as yade-batch has it, with or without a record: a scene
-writes one only if it asks to (``yade_dda.regression.Record``, which writes
-``<description>.json`` into ``$YADE_DDA_RECORDS``; doc/guide/how-to.md, "Batch
-regressions"). Rows done without one are named in the summary, and
+writes one only if it asks to (``yade_dda.tools.regression.Record``, which
+writes ``<description>.json`` into ``$YADE_DDA_RECORDS``; doc/guide/how-to.md,
+"Batch regressions"). Rows done without one are named in the summary, and
 ``examples/regression/check.py`` fails a row whose record is missing.
 
 Retries are Dask's own: when a worker dies (killed, out of memory, node
@@ -72,6 +72,9 @@ NO_RECORD = 'done (wrote no record)'
 LOG_LINES = 12
 """Lines of a failed row's log that are printed."""
 
+_PACKAGE_PARENT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+"""The directory holding this file's yade_dda package (yade_dda/tools/sweep.py): first on the scenes' PYTHONPATH."""
+
 # Run in a new process between the worker and YADE: asks the kernel to SIGKILL this process
 # when the worker thread that started it ends (PR_SET_PDEATHSIG = 1), checks that the worker is
 # still there (it could have died before the request), then becomes YADE (exec keeps the request).
@@ -99,7 +102,7 @@ def lineList(text):
 
 def readTable(table):
     """{line: {column: text}} of a yade-batch table, read by YADE's own reader (as yade-batch reads it)."""
-    from ._yade import utils
+    from .._yade import utils
     return utils.TableParamReader(table).paramDict()
 
 
@@ -144,7 +147,7 @@ def _rowSpec(row, line, table, tableName, scenes, executable, threads, nice, tim
         ['-x', script]
     return {'line': line, 'description': row['description'], 'script': script, 'cwd': scenes,
             'batch': '%s:%d' % (tableName, line), 'command': command, 'env': env, 'timeout': timeout,
-            'pythonpath': os.path.dirname(os.path.dirname(os.path.abspath(__file__)))}
+            'pythonpath': _PACKAGE_PARENT}
 
 
 # ---------------------------------------------------------------- on a worker
@@ -344,7 +347,7 @@ class _LightWorkers:
     """While a local cluster lives: its worker processes do not import yade_dda (which boots YADE).
 
     The tasks are pickled by value (cloudpickle), so no worker needs this
-    module. Under ``python3 -m yade_dda.sweep``, multiprocessing's spawn would
+    module. Under ``python3 -m yade_dda.tools.sweep``, multiprocessing's spawn would
     re-import the main module by its name, package first, in every worker
     (and in each one a nanny restarts); without ``__main__.__spec__`` it runs
     this file by its path instead, which imports only the standard library.
@@ -437,12 +440,12 @@ def runRows(specs, out, workers=None, scheduler=None, retries=3, stream=None, na
 
 def main(argv=None):
     parser = argparse.ArgumentParser(
-        prog='python3 -m yade_dda.sweep', description=__doc__.split('\n\n')[0],
+        prog='python3 -m yade_dda.tools.sweep', description=__doc__.split('\n\n')[0],
         formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog=textwrap.fill("A row is done when its scene exits normally (yade-batch's rule), failed when YADE exits non-zero, "
                "runs past --timeout or loses its worker too often. Records are optional: a scene that is to be "
-               "checked writes one with yade_dda.regression.Record(...).write(), into $YADE_DDA_RECORDS, which the "
-               "sweep sets; rows done without one are named in the summary. examples/regression/check.py TABLE "
+               "checked writes one with yade_dda.tools.regression.Record(...).write(), into $YADE_DDA_RECORDS, "
+               "which the sweep sets; rows done without one are named in the summary. examples/regression/check.py TABLE "
                "--out's DIR then compares the records with their closed forms and references.", 79))
     parser.add_argument('table', help='a yade-batch table with a !SCRIPT column')
     parser.add_argument('--out', required=True, help='directory of the records and logs (<description>.json, .log)')

@@ -8,7 +8,7 @@ A scene is two callables (SI units throughout)::
     def measure():               # after the run: the error against your closed form
         return abs(x - exact)    # a float [your unit], or a dict with at least 'error'
 
-    from yade_dda.accuracy import sweep      # also yade_dda.accuracySweep
+    from yade_dda.tools.accuracy import sweep      # also yade_dda.accuracySweep
     points = sweep(build, measure, knob='dt', values=[1e-2, 1e-3, 1e-4], tEnd=1.0)
 
 For each value, `sweep` resets YADE (``O.reset()``), calls ``build()``, sets
@@ -43,10 +43,10 @@ From the command line, for a script that defines ``build``, ``measure`` and
 import math
 import time
 
-from ._yade import O
-from . import engines as _engines
-from .colliders import MSCCollider
-from .scene import stats
+from .._yade import O
+from .. import engines as _engines
+from ..colliders import MSCCollider
+from ..scene import stats
 
 # knob name -> (engine class name, parameter name, unit)
 KNOBS = {

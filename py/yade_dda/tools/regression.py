@@ -5,7 +5,7 @@ run by ``yade-batch`` with a parameter table whose ``!SCRIPT`` column names
 the script of each row::
 
     from yade_dda import *
-    from yade_dda import regression
+    from yade_dda.tools import regression
     regression.readParamsFromTable(slope=30.0, phi=20.0, dt=1e-3, tEnd=1.0, collider='DESS')
     from yade.params.table import *
     ...                                       # build the scene, run it
@@ -40,7 +40,7 @@ import sys
 import time
 import warnings
 
-from ._yade import O, utils
+from .._yade import O, utils
 
 RECORDS_ENV = 'YADE_DDA_RECORDS'
 """The environment variable naming the directory records are written to (else the working directory)."""
@@ -125,8 +125,8 @@ def versions(script=None):
     """Versions worth keeping with a result: YADE, Python, the yade_dda module in use
     (path and a hash of its compiled core), and the git commit of the scene's source tree."""
     import yade
-    from . import _core
-    yade_dda = sys.modules[__package__]   # the package (loaded before any of its modules), not imported again
+    from .. import _core
+    yade_dda = sys.modules[__name__.split('.')[0]]   # the package (loaded before its modules), not imported again
     out = {'yade': str(yade.config.version), 'python': sys.version.split()[0],
            'yade_dda': getattr(yade_dda, '__version__', None),
            'yade_dda_path': os.path.dirname(os.path.abspath(yade_dda.__file__))}

@@ -15,14 +15,14 @@ import platform
 import statistics
 import time
 
-from ._yade import O, utils, wrapper
-from . import colliders as _colliders
-from . import params as _settings
-from .params import finite, isPoint
-from .blocks import concaveBlock, ddaBlock
-from .engines import DDAIntegrator
-from . import scene as _scene
-from .scene import stats as _stats
+from .._yade import O, utils, wrapper
+from .. import colliders as _colliders
+from .. import params as _settings
+from ..params import finite, isPoint
+from ..blocks import concaveBlock, ddaBlock
+from ..engines import DDAIntegrator
+from .. import scene as _scene
+from ..scene import stats as _stats
 
 # The core's broad phases, MSC (the paper's method, the comparison's reference) first.
 OURS = ('MSC',) + tuple(name for name in _settings.COLLIDERS if name != 'MSC')
