@@ -189,10 +189,11 @@ void World::settle(const IntegratorSettings& settings) {
 	statics.maxTimeStep = longest;
 	settling_ = true;
 	frictionScale_ = kSettleFrictionScale;
-	openClose_.setScaledFriction(true);
+	openClose_.setOnePass(false);
 	openClose_.setCoulombSafe(false);
 	frozen_.clear();
 	settleSteps_ = 0;
+	settleSolves_ = settleLimitPasses_ = 0;
 	settleConverged_ = false;
 	unsettled_.clear();
 	double first = -1;
@@ -202,11 +203,11 @@ void World::settle(const IntegratorSettings& settings) {
 		lockSettledContacts();
 	}
 	settling_ = false;
-	openClose_.setScaledFriction(false);
+	openClose_.setOnePass(false);
 	openClose_.setCoulombSafe(true);
 	frictionScale_ = 1;
 	frozen_.clear();
-	if (settledBlocks_ == 0) settleSteps_ = 0;  // nothing to settle: not tried
+	if (settledBlocks_ == 0) settleSteps_ = settleSolves_ = settleLimitPasses_ = 0;  // nothing to settle: not tried
 	if (!settleConverged_) {
 		blocks_ = placed;
 		store_ = placedContacts;
@@ -263,6 +264,8 @@ bool World::staticStep(const IntegratorSettings& statics, double longest) {
 	++settleSteps_;
 	try {
 		advance(statics);
+		settleSolves_ += stats_.openCloseIterationsTotal;
+		settleLimitPasses_ += stats_.limitPasses;
 	} catch (const std::exception&) {
 		// No static solution with these contacts (a system no inertia
 		// keeps definite).
@@ -272,6 +275,12 @@ bool World::staticStep(const IntegratorSettings& statics, double longest) {
 	// keeps its velocity.
 	for (int b = 0; b < blockCount(); ++b)
 		if (!blocks_[b].fixed && !frozen_[b]) blocks_[b].velocity.setZero();
+	// With friction scaled up (the locked stage and the ramp) the static
+	// steps after the first make one pass each: their limits follow the
+	// normal forces from one static step to the next (DESIGN, "Start from
+	// rest"). The first starts from contacts at no normal force, so no
+	// limit; it settles its limits pass by pass.
+	openClose_.setOnePass(frictionScale_ != 1);
 	return true;
 }
 
@@ -309,7 +318,7 @@ void World::admitFriction(const IntegratorSettings& statics, double longest, dou
 		}
 	}
 	frictionScale_ = 1;
-	openClose_.setScaledFriction(false);
+	openClose_.setOnePass(false);
 	if (ramped && settlingSteps(statics, longest, reference)) return;
 	blocks_ = locked;
 	store_ = lockedContacts;

@@ -222,6 +222,8 @@ double World::step(const IntegratorSettings& settings) {
 	settleTried_ = true;
 	const double dt = advance(settings);
 	stats_.settleSteps = settleSteps_;
+	stats_.settleSolves = settleSolves_;
+	stats_.settleLimitPasses = settleLimitPasses_;
 	stats_.settledBlocks = settledBlocks_;
 	stats_.settleConverged = settleConverged_;
 	return dt;

@@ -166,6 +166,7 @@ private:
 	double frictionScale_ = 1;   // friction tangents x this (settling: locked)
 	bool settleTried_ = false;
 	int settleSteps_ = 0, settledBlocks_ = 0;
+	long settleSolves_ = 0, settleLimitPasses_ = 0;
 	bool settleConverged_ = false;
 	std::vector<int> unsettled_;  // see unsettledBlocks()
 
