@@ -189,7 +189,7 @@ void World::settle(const IntegratorSettings& settings) {
 	statics.maxTimeStep = longest;
 	settling_ = true;
 	frictionScale_ = kSettleFrictionScale;
-	openClose_.setOnePass(false);
+	openClose_.setScaledFriction(true);
 	openClose_.setCoulombSafe(false);
 	frozen_.clear();
 	settleSteps_ = 0;
@@ -203,7 +203,7 @@ void World::settle(const IntegratorSettings& settings) {
 		lockSettledContacts();
 	}
 	settling_ = false;
-	openClose_.setOnePass(false);
+	openClose_.setScaledFriction(false);
 	openClose_.setCoulombSafe(true);
 	frictionScale_ = 1;
 	frozen_.clear();
@@ -275,12 +275,6 @@ bool World::staticStep(const IntegratorSettings& statics, double longest) {
 	// keeps its velocity.
 	for (int b = 0; b < blockCount(); ++b)
 		if (!blocks_[b].fixed && !frozen_[b]) blocks_[b].velocity.setZero();
-	// With friction scaled up (the locked stage and the ramp) the static
-	// steps after the first make one pass each: their limits follow the
-	// normal forces from one static step to the next (DESIGN, "Start from
-	// rest"). The first starts from contacts at no normal force, so no
-	// limit; it settles its limits pass by pass.
-	openClose_.setOnePass(frictionScale_ != 1);
 	return true;
 }
 
@@ -318,7 +312,7 @@ void World::admitFriction(const IntegratorSettings& statics, double longest, dou
 		}
 	}
 	frictionScale_ = 1;
-	openClose_.setOnePass(false);
+	openClose_.setScaledFriction(false);
 	if (ramped && settlingSteps(statics, longest, reference)) return;
 	blocks_ = locked;
 	store_ = lockedContacts;

@@ -47,6 +47,8 @@ def test_settled_contacts_carry_the_weight(scene, slope):
     O.run(1, True)
     s = yade_dda.stats()
     assert s['settleConverged'] and s['settledBlocks'] == 1 and s['settleSteps'] >= 1, s
+    # Every static step makes at least one solve, and a pass is at least one.
+    assert s['settleSolves'] >= s['settleSteps'] + s['settleLimitPasses'], s
     mass = yade_dda.block(cube).mass
     closed = yade_dda.contacts('closed')
     assert len(closed) == 4
@@ -123,7 +125,8 @@ def test_nothing_to_settle_runs_bitwise_as_placed(scene):
         O.engines = [DDAIntegrator(dt=1e-3, gravity=(0, 0, -G), startFromRest=start)]
         O.run(1, True)
         if start:
-            assert yade_dda.stats()['settleSteps'] == 0
+            s = yade_dda.stats()
+            assert s['settleSteps'] == s['settleSolves'] == s['settleLimitPasses'] == 0, s
         O.run(400, True)
         runs[start] = [tuple(yade_dda.block(c).centroid) + tuple(yade_dda.block(c).velocity) for c in cubes]
     assert runs[True] == runs[False]
