@@ -31,9 +31,6 @@ constexpr double kNewtonTolerance = 1e-10;
 // top.) Any limit >= 0 resists slip, so an unsettled limit is an error in
 // the friction's size, not in the energy.
 constexpr double kLimitTolerance = 1e-3;
-// While friction is scaled up (setScaledFriction) the limits themselves must
-// settle to this fraction of the group's largest.
-constexpr double kScaledLimitTolerance = 1e-3;
 constexpr int kLimitPasses = 12;
 // Coulomb-safe passes (closePasses) first set every limit to its normal
 // force's, this many times, then only lower them.
@@ -223,8 +220,9 @@ bool OpenCloseIteration::evaluateStates(const Attempt& attempt) {
 		// a finite number of times): frictionless until the next pass,
 		// a block landing on a much larger one was held sideways by its
 		// inertia alone, and the system's Cholesky failed on round-off
-		// at five decades of scale.
-		if (isClosed(contact) && !(contact.slipLimit > 0) && contact.trial.normalForce > 0 &&
+		// at five decades of scale. Not in a step of one pass
+		// (setOnePass), whose limits are those of its start.
+		if (!onePass_ && isClosed(contact) && !(contact.slipLimit > 0) && contact.trial.normalForce > 0 &&
 		    contact.frictionTangent > 0) {
 			updateFrictionLimit(contact, true);
 			evaluateContact(contact, blockI, blockJ, Di, Dj);
@@ -261,21 +259,9 @@ void OpenCloseIteration::measureLimits(std::vector<Contact>& contacts) {
 		const int g = contactGroup_[c];
 		return !group_.done[g] && group_.passConverged(g, kNewtonTolerance);
 	};
-	if (scaledFriction_) {
-		// Start from rest's locked stage: the limits are far above any
-		// force the springs carry, and what must settle is the normal
-		// forces they follow, so the limits themselves count, against the
-		// group's largest limit as in a dynamic step's test before the
-		// force test replaced it.
-		for (std::size_t c = 0; c < contacts.size(); ++c) {
-			if (!converged(c)) continue;
-			const double change = updateFrictionLimit(contacts[c], false);
-			const int g = contactGroup_[c];
-			group_.limitChange[g] = std::max(group_.limitChange[g], change);
-			group_.largestLimit[g] = std::max(group_.largestLimit[g], contacts[c].slipLimit + change);
-		}
-		return;
-	}
+	// One pass a step (setOnePass): the limits are those of the step's
+	// start, settled across static steps rather than within each.
+	if (onePass_) return;
 	const int n = static_cast<int>(moving_.size());
 	blockLimit_.assign(n, 0.0);
 	for (std::size_t c = 0; c < contacts.size(); ++c) {
@@ -324,9 +310,10 @@ bool OpenCloseIteration::closePasses(int iterations, const Attempt& attempt, int
 		const bool converged = group_.passConverged(g, kNewtonTolerance);
 		// In Coulomb-safe passes limitChange is the largest excess of a
 		// friction force over Coulomb's limit at its normal force.
-		const bool settled = scaledFriction_
-		                         ? group_.limitChange[g] <= kScaledLimitTolerance * group_.largestLimit[g]
-		                         : group_.limitChange[g] <= kLimitTolerance;
+		// One pass a step (World::settle's locked stage and ramp after
+		// their first static step, see setOnePass): a converged pass ends
+		// the step.
+		const bool settled = onePass_ || group_.limitChange[g] <= kLimitTolerance;
 		// The passes a group may make to settle its limits: kLimitPasses,
 		// and none once three quarters of the step's solves are spent.
 		const bool outOfPasses = iterations >= (3 * maxIterations) / 4 || group_.passes[g] + 1 >= kLimitPasses;
@@ -339,11 +326,10 @@ bool OpenCloseIteration::closePasses(int iterations, const Attempt& attempt, int
 			exhausted = exhausted || iterations >= solveBudget(maxIterations, group_.coulombSafe[g] > 0);
 			continue;
 		}
-		if ((scaledFriction_ || !coulombSafe_) && outOfPasses) {
-			// Start from rest's static steps accept a converged pass with its
-			// limits as they stand (its locked stage's limits stand far
-			// above the springs' forces); its end state is checked
-			// (World::settle).
+		if (!coulombSafe_ && outOfPasses) {
+			// Start from rest's static steps with the true friction accept a
+			// converged pass with its limits as they stand; its end state is
+			// checked (World::settle).
 			group_.done[g] = 1;
 			++stats.limitsUnsettled;
 			continue;
@@ -436,7 +422,6 @@ void OpenCloseIteration::GroupIteration::reset(int groups) {
 	forceChange.assign(groups, 0.0);
 	largestNormalForce.assign(groups, 0.0);
 	limitChange.assign(groups, 0.0);
-	largestLimit.assign(groups, 0.0);
 }
 
 void OpenCloseIteration::GroupIteration::startIteration() {
@@ -445,14 +430,14 @@ void OpenCloseIteration::GroupIteration::startIteration() {
 		++passSolves[g];
 		changes[g] = 0;
 		newPass[g] = 0;
-		forceChange[g] = largestNormalForce[g] = limitChange[g] = largestLimit[g] = 0;
+		forceChange[g] = largestNormalForce[g] = limitChange[g] = 0;
 	}
 }
 
 std::size_t OpenCloseIteration::GroupIteration::memoryBytes() const {
 	return capacityBytes(done) + capacityBytes(hasContacts) + capacityBytes(swungBack) + capacityBytes(newPass) +
 	       capacityBytes(coulombSafe) + capacityBytes(passes) + capacityBytes(passSolves) + capacityBytes(changes) + capacityBytes(forceChange) +
-	       capacityBytes(largestNormalForce) + capacityBytes(limitChange) + capacityBytes(largestLimit);
+	       capacityBytes(largestNormalForce) + capacityBytes(limitChange);
 }
 
 bool OpenCloseIteration::GroupIteration::passConverged(int g, double tolerance) const {

@@ -52,10 +52,13 @@ public:
 		coupled_.setAnalysisReuse(reuse);
 		keepTerms_ = reuse;
 	}
-	// Whether the friction is scaled up (World::settle's locked stage and
-	// its ramp): the passes' limit test then compares the limits
-	// themselves, not the tangential forces they would move (measureLimits).
-	void setScaledFriction(bool scaled) { scaledFriction_ = scaled; }
+	// Whether a step makes one pass: its friction limits are those of its
+	// start (set from each contact's normal force there; a contact that
+	// closes during the step takes none), and a converged pass ends it
+	// (closePasses). World::settle's locked stage and ramp after their first
+	// static step: their limits follow the normal forces from one static
+	// step to the next.
+	void setOnePass(bool onePass) { onePass_ = onePass; }
 	// Whether limits that do not settle end Coulomb-safe (closePasses; off
 	// in World::settle's static steps, which accept them as they stand).
 	void setCoulombSafe(bool safe) { coulombSafe_ = safe; }
@@ -135,8 +138,8 @@ private:
 	std::vector<int> keptTermsOf_;             // per contact: its entry of keptTerms_, -1 if none
 	std::vector<unsigned char> keptTermsKey_;  // per contact: the state its kept terms are for
 	bool keepTerms_ = true;
-	bool scaledFriction_ = false;
 	bool coulombSafe_ = true;
+	bool onePass_ = false;
 	// Newmark's start acceleration a0 of each moving block (unless Shi's
 	// scheme, which does not read it): M^-1 times the block's own forces at
 	// D = 0 (restForce). Contacts are left out: they enter as the step's mean
@@ -170,9 +173,8 @@ private:
 		// coulombSafe: 0 while the group's passes settle its limits, then
 		// 1 + the Coulomb-safe passes it has started (closePasses).
 		std::vector<int> passes, passSolves, changes, coulombSafe;
-		// limitChange: relative to its contacts' scales, or (scaled friction)
-		// in newtons against largestLimit.
-		std::vector<double> forceChange, largestNormalForce, limitChange, largestLimit;
+		// limitChange: relative to its contacts' scales.
+		std::vector<double> forceChange, largestNormalForce, limitChange;
 		void reset(int groups);
 		void startIteration();
 		bool passConverged(int g, double tolerance) const;
