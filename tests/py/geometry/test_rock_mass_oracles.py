@@ -387,7 +387,8 @@ REST_RUNS = ([('junctions', 0, 5.0, 0.2), ('oblique', 1, SIDE, 0.2)]
                 for kind in ('oblique', 'orthogonal') for seed in (1, 2, 3, 4, 5)]
              + [pytest.param('junctions', 0, 5.0, 0.5, marks=pytest.mark.slow)]
              + [pytest.param(kind, 1, 6.0, 0.5, marks=pytest.mark.slow) for kind in ('oblique', 'orthogonal')]
-             + [pytest.param('orthogonal', 1, 8.0, 0.2, marks=pytest.mark.slow)])
+             + [pytest.param('orthogonal', 1, 8.0, 0.2, marks=pytest.mark.slow)]
+             + [pytest.param('orthogonal', 1, 10.0, 0.5, marks=pytest.mark.slow)])
 # The start from rest's static steps: at most this many open-close solves each on average. With
 # friction locked or ramped a static step is one pass of Newton solves (World::staticStep; 10 to 15
 # on the masses here, where limits settled pass by pass within each step took 60 to 80).
