@@ -310,10 +310,9 @@ bool OpenCloseIteration::closePasses(int iterations, const Attempt& attempt, int
 		const bool converged = group_.passConverged(g, kNewtonTolerance);
 		// In Coulomb-safe passes limitChange is the largest excess of a
 		// friction force over Coulomb's limit at its normal force.
-		// One pass a step (World::settle's locked stage and ramp after
-		// their first static step, see setOnePass): a converged pass ends
-		// the step.
-		const bool settled = onePass_ || group_.limitChange[g] <= kLimitTolerance;
+		// (A step of one pass measures no limit change, measureLimits: its
+		// converged pass is settled.)
+		const bool settled = group_.limitChange[g] <= kLimitTolerance;
 		// The passes a group may make to settle its limits: kLimitPasses,
 		// and none once three quarters of the step's solves are spent.
 		const bool outOfPasses = iterations >= (3 * maxIterations) / 4 || group_.passes[g] + 1 >= kLimitPasses;

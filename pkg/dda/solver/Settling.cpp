@@ -189,7 +189,6 @@ void World::settle(const IntegratorSettings& settings) {
 	statics.maxTimeStep = longest;
 	settling_ = true;
 	frictionScale_ = kSettleFrictionScale;
-	openClose_.setOnePass(false);
 	openClose_.setCoulombSafe(false);
 	frozen_.clear();
 	settleSteps_ = 0;
@@ -262,19 +261,6 @@ bool World::settlingSteps(const IntegratorSettings& statics, double longest, dou
 bool World::staticStep(const IntegratorSettings& statics, double longest) {
 	timeStep_.setNextTry(longest);
 	++settleSteps_;
-	try {
-		advance(statics);
-		settleSolves_ += stats_.openCloseIterationsTotal;
-		settleLimitPasses_ += stats_.limitPasses;
-	} catch (const std::exception&) {
-		// No static solution with these contacts (a system no inertia
-		// keeps definite).
-		return false;
-	}
-	// The settling blocks only: a frozen one (moving, or unsupported)
-	// keeps its velocity.
-	for (int b = 0; b < blockCount(); ++b)
-		if (!blocks_[b].fixed && !frozen_[b]) blocks_[b].velocity.setZero();
 	// With friction scaled up (the locked stage and the ramp) every static
 	// step after the first makes one pass (OpenCloseIteration::setOnePass):
 	// its friction limits are set from the normal forces at its start, a
@@ -299,7 +285,20 @@ bool World::staticStep(const IntegratorSettings& statics, double longest) {
 	// fifteen masses and the 8 m, slope and persistence masses of
 	// bench/rock_mass_rest.py and the start from rest, random slope, rock-mass
 	// oracle, Coulomb-safe, dt-convergence, wedge and tunnel suites.
-	openClose_.setOnePass(frictionScale_ != 1);
+	openClose_.setOnePass(frictionScale_ != 1 && settleSteps_ > 1);
+	try {
+		advance(statics);
+		settleSolves_ += stats_.openCloseIterationsTotal;
+		settleLimitPasses_ += stats_.limitPasses;
+	} catch (const std::exception&) {
+		// No static solution with these contacts (a system no inertia
+		// keeps definite).
+		return false;
+	}
+	// The settling blocks only: a frozen one (moving, or unsupported)
+	// keeps its velocity.
+	for (int b = 0; b < blockCount(); ++b)
+		if (!blocks_[b].fixed && !frozen_[b]) blocks_[b].velocity.setZero();
 	return true;
 }
 
@@ -337,7 +336,6 @@ void World::admitFriction(const IntegratorSettings& statics, double longest, dou
 		}
 	}
 	frictionScale_ = 1;
-	openClose_.setOnePass(false);
 	if (ramped && settlingSteps(statics, longest, reference)) return;
 	blocks_ = locked;
 	store_ = lockedContacts;
