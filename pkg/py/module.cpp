@@ -18,6 +18,8 @@
 namespace py = boost::python;
 using namespace dda;
 
+void registerSystemExport(py::class_<SceneLink, boost::noncopyable>& scene);  // pkg/py/SystemExport.cpp
+
 namespace {
 
 Vector3 toVector(const py::object& item, const char* what) {
@@ -502,6 +504,7 @@ void registerScene() {
 	    .def("loadState", &loadState,
 	         "Replaces this scene by a state from saveState; ValueError naming the problem (and no change) if it cannot.");
 	registerConcaveBlocks(scene);
+	registerSystemExport(scene);
 }
 
 // _core.YadeSync (pkg/py/YadeSync.hpp).

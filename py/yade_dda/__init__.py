@@ -32,7 +32,7 @@ from .colliders import MSCCollider, DESSCollider, NBSCollider, AllPairsCollider
 from .recorder import DDAVTKRecorder
 from .saveload import Checkpoint, latestCheckpoint, writeCheckpoint, storeState, restoreState
 from .scene import (stats, sync, block, blockOf, setVelocity, addPointLoad, addFixedPoint,
-                    printStats, contacts, Ig2_DDABlock_DDABlock_DDAContact)
+                    printStats, contacts, coupledSystem, Ig2_DDABlock_DDABlock_DDAContact)
 
 from . import saveload as _saveload
 from .typedengines import typedEngines as _typedEngines
@@ -42,7 +42,7 @@ _saveload.onLoad(_typedEngines)
 
 __all__ = ['ddaBlock', 'rigidBlock', 'concaveBlock', 'boxCorners', 'cutRockMass', 'DDAIntegrator', 'MSCCollider', 'DESSCollider', 'NBSCollider', 'AllPairsCollider',
            'Checkpoint', 'latestCheckpoint', 'DDAVTKRecorder', 'stats', 'printStats', 'sync', 'block', 'blockOf',
-           'setVelocity', 'addPointLoad', 'addFixedPoint', 'contacts', 'Ig2_DDABlock_DDABlock_DDAContact', 'O']
+           'setVelocity', 'addPointLoad', 'addFixedPoint', 'contacts', 'coupledSystem', 'Ig2_DDABlock_DDABlock_DDAContact', 'O']
 
 _TOOLS = ('compareColliders', 'accuracySweep')
 """Tools of yade_dda.tools that are also names of the package: loaded on first use, out of ``import *``."""

@@ -520,6 +520,54 @@ class ContactView:
                 % (self.kind, self.id1, self.id2, self.type, self.state, self.normalForce))
 
 
+def coupledSystem():
+    """The coupled system K D = F of the last step's last solve, as NumPy arrays.
+
+    One row per moving block that closed contacts or fixed points couple
+    (a block row of 12 unknowns: translation [m], rotation [rad], normal and
+    engineering shear strains, at its centroid; a rigid block's strain rows
+    are not unknowns), and one link per pair of rows that a closed contact
+    joins. A dict:
+
+    - ``bodies``: the body id of each row (a list of n ints);
+    - ``sizes``: (n,) its unknowns, 12, or 6 for a rigid block;
+    - ``centroids``: (n, 3) the points its unknowns refer to [m];
+    - ``diagonal``: (n, 12, 12) K's diagonal blocks (symmetric) [N/m, N, N m];
+    - ``links``: (m, 2) the rows (lo, hi), lo < hi, of each off-diagonal block;
+    - ``offDiagonal``: (m, 12, 12) K[lo][hi] (K[hi][lo] is its transpose);
+    - ``force``: (n, 12) F [N, N m];
+    - ``components``: (c + 1,) independent systems' first rows (component
+      i is rows components[i] .. components[i+1]-1).
+
+    Example: the dense matrix, and the solution the solve found::
+
+        s = yade_dda.coupledSystem()
+        n = len(s['bodies'])
+        K = numpy.zeros((12 * n, 12 * n))
+        for k, d in enumerate(s['diagonal']):
+            K[12 * k:12 * k + 12, 12 * k:12 * k + 12] = d
+        for (lo, hi), b in zip(s['links'], s['offDiagonal']):
+            K[12 * lo:12 * lo + 12, 12 * hi:12 * hi + 12] = b
+            K[12 * hi:12 * hi + 12, 12 * lo:12 * lo + 12] = b.T
+        D = numpy.linalg.solve(K, s['force'].ravel()).reshape(n, 12)
+
+    (With rigid blocks, strike their strain rows and columns first.)
+    """
+    import numpy
+    raw = _require().core.coupledSystem()
+    n, m = raw['rows'], raw['links']
+    bodyOf = _require().bodyOfBlock
+    blocks = numpy.frombuffer(raw['blocks'], dtype=numpy.int32)
+    return dict(bodies=[int(bodyOf[b]) for b in blocks],
+                sizes=numpy.frombuffer(raw['sizes'], dtype=numpy.int32).copy(),
+                centroids=numpy.frombuffer(raw['centroids'], dtype=numpy.float64).reshape(n, 3).copy(),
+                diagonal=numpy.frombuffer(raw['diagonal'], dtype=numpy.float64).reshape(n, 12, 12).copy(),
+                links=numpy.frombuffer(raw['linkRows'], dtype=numpy.int32).reshape(m, 2).copy(),
+                offDiagonal=numpy.frombuffer(raw['offDiagonal'], dtype=numpy.float64).reshape(m, 12, 12).copy(),
+                force=numpy.frombuffer(raw['force'], dtype=numpy.float64).reshape(n, 12).copy(),
+                components=numpy.frombuffer(raw['componentStarts'], dtype=numpy.int32).copy())
+
+
 def contacts(state=None):
     """The DDA sub-contacts of the last step as a list of ContactView.
 

@@ -31,7 +31,7 @@ bool BlockConjugateGradient::threaded() const {
 #endif
 }
 
-bool BlockConjugateGradient::prepare(const Matrix& matrix, int threadsFrom) {
+bool BlockConjugateGradient::prepare(const Matrix& matrix, int threadsFrom, int coarseFrom) {
 	matrix_ = matrix;
 	threadsFrom_ = threadsFrom;
 	const int n = matrix.blocks;
@@ -95,12 +95,17 @@ bool BlockConjugateGradient::prepare(const Matrix& matrix, int threadsFrom) {
 		positive = positive && factor.info() == Eigen::Success;
 		diagonalInverse_[k] = factor.solve(Matrix12::Identity());
 	}
+	coarseOn_ = positive && matrix.centroids && coarseFrom > 0 && n >= coarseFrom && prepareCoarse();
 	r_.resize(n);
 	z_.resize(n);
 	p_.resize(n);
 	q_.resize(n);
 	partial_.resize((n + kChunkBlocks - 1) / kChunkBlocks);
 	return positive;
+}
+
+bool BlockConjugateGradient::prepareCoarse() {
+	return coarse_.prepare(AffineCoarseSpace::Fine{matrix_, rowStart_.data(), neighbour_.data()});
 }
 
 void BlockConjugateGradient::restrictRigid(std::vector<Vector12>& v) const {
@@ -130,6 +135,7 @@ void BlockConjugateGradient::precondition(const std::vector<Vector12>& r, std::v
 	const int n = matrix_.blocks;
 #pragma omp parallel for schedule(static) if (threaded())
 	for (int k = 0; k < n; ++k) z[k].noalias() = diagonalInverse_[k].lazyProduct(r[k]);
+	if (coarseOn_) coarse_.addCorrection(r, z, threaded());
 }
 
 double BlockConjugateGradient::dot(const std::vector<Vector12>& a, const std::vector<Vector12>& b) const {
@@ -208,7 +214,7 @@ bool BlockConjugateGradient::solve(const Vector12* bIn, Vector12* xInOut, double
 std::size_t BlockConjugateGradient::memoryBytes() const {
 	return capacityBytes(rowStart_) + capacityBytes(neighbour_) + capacityBytes(link_) + capacityBytes(rigid_) +
 	       capacityBytes(diagonalInverse_) + capacityBytes(r_) + capacityBytes(z_) + capacityBytes(p_) +
-	       capacityBytes(q_) + capacityBytes(partial_);
+	       capacityBytes(q_) + capacityBytes(partial_) + (coarseOn_ ? coarse_.memoryBytes() : 0);
 }
 
 }  // namespace dda

@@ -36,6 +36,9 @@
 // iterates' strain parts stay exactly zero.
 #pragma once
 
+#include "AffineCoarseSpace.hpp"
+#include "BlockSparseMatrix.hpp"
+
 #include "dda/block/Displacement.hpp"
 
 #include <cstddef>
@@ -46,23 +49,15 @@ namespace dda {
 
 class BlockConjugateGradient {
 public:
-	// The matrix: `blocks` block rows; diagonal[k] (its lower triangle is
-	// read), offDiagonal[l] = K[lo][hi] of links[l] = (lo, hi), lo < hi,
-	// sorted, no duplicates; sizes[k] = 12, or 6 for a rigid block. The
-	// arrays must outlive the solves.
-	struct Matrix {
-		int blocks = 0;
-		const Matrix12* diagonal = nullptr;
-		const Matrix12* offDiagonal = nullptr;
-		const std::pair<int, int>* links = nullptr;
-		int linkCount = 0;
-		const int* sizes = nullptr;
-	};
+	// The matrix (BlockSparseMatrix.hpp).
+	using Matrix = BlockSparseMatrix;
 
 	// Takes the matrix and inverts its diagonal blocks (the preconditioner);
 	// false when one is not positive definite. Rows are threaded when there
-	// are at least `threadsFrom` blocks (and more than one thread).
-	bool prepare(const Matrix& matrix, int threadsFrom);
+	// are at least `threadsFrom` blocks (and more than one thread). With
+	// centroids and at least `coarseFrom` blocks (coarseFrom > 0), the
+	// preconditioner adds the coarse level (AffineCoarseSpace.hpp).
+	bool prepare(const Matrix& matrix, int threadsFrom, int coarseFrom = 0);
 
 	// Solves K x = b; x holds the first iterate on entry (a rigid block's
 	// strain part is ignored) and the solution on return. Returns whether the
@@ -72,6 +67,8 @@ public:
 	// The last solve's iterations and the backward error of its result.
 	int iterations() const { return iterations_; }
 	double backwardError() const { return backwardError_; }
+	// Aggregates of the coarse level (0 without one).
+	int coarseAggregates() const { return coarseOn_ ? coarse_.aggregates() : 0; }
 	// Heap held [bytes].
 	std::size_t memoryBytes() const;
 
@@ -83,6 +80,9 @@ private:
 	double dot(const std::vector<Vector12>& a, const std::vector<Vector12>& b) const;
 	double largest(const std::vector<Vector12>& a) const;
 	void restrictRigid(std::vector<Vector12>& v) const;
+	// The coarse level of the prepared matrix; false when its matrix is not
+	// positive definite (then block Jacobi alone).
+	bool prepareCoarse();
 	bool threaded() const;
 
 	Matrix matrix_;
@@ -93,6 +93,8 @@ private:
 	std::vector<int> rowStart_, neighbour_, link_;
 	std::vector<char> rigid_;
 	std::vector<Matrix12> diagonalInverse_;
+	AffineCoarseSpace coarse_;
+	bool coarseOn_ = false;
 	std::vector<Vector12> r_, z_, p_, q_;
 	mutable std::vector<double> partial_;
 	int iterations_ = 0;

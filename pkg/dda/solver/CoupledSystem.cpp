@@ -412,9 +412,15 @@ bool CoupledSystem::iterateComponent(int c, std::vector<Vector12>& solutions, in
 	matrix.links = links.data();
 	matrix.linkCount = static_cast<int>(links.size());
 	matrix.sizes = &unknowns_[first];
+	if (centroids_ && coarseFrom_ > 0 && last - first >= coarseFrom_) {
+		slotCentroids_.resize(last - first);
+		for (int s = first; s < last; ++s) slotCentroids_[s - first] = (*centroids_)[members_[s]];
+		matrix.centroids = slotCentroids_.data();
+	}
 	BlockConjugateGradient& solver = iterative_;
 	iterations = 0;
-	if (!solver.prepare(matrix, std::min(threadsFrom, kIterativeThreadsFrom))) return false;
+	if (!solver.prepare(matrix, std::min(threadsFrom, kIterativeThreadsFrom), coarseFrom_)) return false;
+	coarseAggregates_ += solver.coarseAggregates();
 	// The first iterate: this attempt's last solution (the open-close
 	// iteration's systems differ by a few contacts' terms), else zero.
 	std::vector<Vector12> x(last - first, Vector12::Zero());
@@ -434,6 +440,7 @@ void CoupledSystem::iterateLargeComponents(std::vector<Vector12>& solutions, int
 	// not converge is factorised by solveOtherComponents.
 	const int count = components();
 	iterated.assign(count, 0);
+	coarseAggregates_ = 0;
 	int done = 0, iterations = 0, fallbacks = 0;
 	for (int c = 0; iterativeFrom_ > 0 && c < count; ++c) {
 		const int first = componentStart_[c], last = componentStart_[c + 1];

@@ -115,6 +115,17 @@ public:
 	void solve(std::vector<Vector12>& solutions, int threadsFrom);
 
 	int components() const { return static_cast<int>(componentStart_.size()) - 1; }
+	// The last assembly, as solved (for export, yade_dda.coupledSystem):
+	// per slot its moving block, unknowns, diagonal block (K in its lower
+	// triangle) and force; per link its slots (lo, hi) and K[lo][hi];
+	// component c holds slots componentStarts()[c] .. componentStarts()[c+1]-1.
+	const std::vector<int>& slotBlocks() const { return members_; }
+	const std::vector<int>& slotUnknowns() const { return unknowns_; }
+	const std::vector<Matrix12>& diagonalBlocks() const { return diagonal_; }
+	const std::vector<Vector12>& forces() const { return force_; }
+	const std::vector<std::pair<int, int>>& linkSlots() const { return linkSlots_; }
+	const std::vector<Matrix12>& offDiagonalBlocks() const { return offDiagonal_; }
+	const std::vector<int>& componentStarts() const { return componentStart_; }
 	int largestComponent() const;
 	// Unknowns factorised by the last solve, all components together.
 	long solvedUnknowns() const { return solvedUnknowns_; }
@@ -147,13 +158,22 @@ public:
 	// are solved by preconditioned conjugate gradients to the backward error
 	// `tolerance` (then factorised if it has not within
 	// kMaxIterativeIterations); fromBlocks <= 0 turns it off.
-	void setIterative(int fromBlocks, double tolerance) {
+	// Components of at least `coarseFrom` blocks (coarseFrom > 0) add the
+	// coarse level to its preconditioner (AffineCoarseSpace.hpp), which
+	// needs the moving blocks' centroids (setCentroids).
+	void setIterative(int fromBlocks, double tolerance, int coarseFrom = 0) {
 		iterativeFrom_ = fromBlocks;
 		iterativeTolerance_ = tolerance;
+		coarseFrom_ = coarseFrom;
 	}
+	// Per moving block, the point its unknowns refer to [m]; the vector must
+	// outlive the solves.
+	void setCentroids(const std::vector<Vector3>* centroids) { centroids_ = centroids; }
 	// Components the last solve solved iteratively, their iterations, and
 	// those that did not converge (and were factorised).
 	int iterativeComponents() const { return iterativeComponents_; }
+	// Aggregates of the coarse levels of the last solve (all components).
+	int coarseAggregates() const { return coarseAggregates_; }
 	int iterativeIterations() const { return iterativeIterations_; }
 	int iterativeFallbacks() const { return iterativeFallbacks_; }
 
@@ -220,11 +240,13 @@ private:
 	// The iterative path: settings, its solver (the components it takes run
 	// one after another), and whether the solutions hold this attempt's last
 	// solve (the first iterate).
-	int iterativeFrom_ = 0;
+	int iterativeFrom_ = 0, coarseFrom_ = 0;
 	double iterativeTolerance_ = 0;
+	const std::vector<Vector3>* centroids_ = nullptr;
+	std::vector<Vector3> slotCentroids_;
 	BlockConjugateGradient iterative_;
 	bool warm_ = false;
-	int iterativeComponents_ = 0, iterativeIterations_ = 0, iterativeFallbacks_ = 0;
+	int iterativeComponents_ = 0, iterativeIterations_ = 0, iterativeFallbacks_ = 0, coarseAggregates_ = 0;
 	// Solves component c iteratively; true when it converged.
 	bool iterateComponent(int c, std::vector<Vector12>& solutions, int& iterations, int threadsFrom);
 	// solve's parts: the iterative path's components (iterated[c] set for

@@ -141,7 +141,11 @@ void OpenCloseIteration::startAttempt(const Attempt& attempt, bool firstStep) {
 	if (!attempt.settings.gravity.isZero()) attempt.stats.bodyForceBlocks += n;
 	iterate_.assign(n, Vector12::Zero());
 	coupled_.beginAttempt(attempt.settings.refineSolves);
-	coupled_.setIterative(attempt.settings.iterativeSolveBlocks, attempt.settings.iterativeTolerance);
+	coupled_.setIterative(attempt.settings.iterativeSolveBlocks, attempt.settings.iterativeTolerance,
+	                      attempt.settings.iterativeCoarseBlocks);
+	centroids_.resize(n);
+	for (int k = 0; k < n; ++k) centroids_[k] = attempt.blocks[moving_[k]].centroid;
+	coupled_.setCentroids(&centroids_);
 	keptTerms_.clear();
 	keptTermsOf_.assign(contacts.size(), -1);
 	for (Contact& contact : contacts) {
@@ -187,6 +191,7 @@ void OpenCloseIteration::solveOnce(const Attempt& attempt, bool structureStale) 
 	stats.iterativeComponents += coupled_.iterativeComponents();
 	stats.iterativeIterations += coupled_.iterativeIterations();
 	stats.iterativeFallbacks += coupled_.iterativeFallbacks();
+	stats.coarseAggregates = coupled_.coarseAggregates();
 	if (lineSearch(attempt) < 1) ++stats.lineSearches;
 	stats.timeSolve += secondsSince(phase);
 }

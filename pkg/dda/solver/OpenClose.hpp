@@ -28,6 +28,10 @@ public:
 	// none is). Fills stats' block and unknown counts.
 	void selectMovingBlocks(const std::vector<Block>& blocks, const std::vector<char>& frozen, StepStatistics& stats);
 	const std::vector<int>& moving() const { return moving_; }
+	// The coupled system of the last solve, and the moving blocks' centroids
+	// its unknowns refer to [m] (for export).
+	const CoupledSystem& coupledSystem() const { return coupled_; }
+	const std::vector<Vector3>& solveCentroids() const { return centroids_; }
 	// A block's index in moving(), -1 for fixed (or frozen) blocks.
 	int movingIndex(int block) const { return movingIndex_[block]; }
 	// One attempt of the step at dt: the open-close iteration over `contacts`
@@ -192,6 +196,7 @@ private:
 	// per-step work arrays, kept to avoid reallocation
 	std::vector<int> moving_;
 	std::vector<Vector12> solutions_;  // the last Newton solution, per moving block
+	std::vector<Vector3> centroids_;   // per moving block at the attempt's start (the coarse level's)
 	std::vector<Vector12> iterate_;    // the current iterate of the step's iteration
 	std::vector<Vector12> deltas_;     // lineSearch's work arrays
 	std::vector<ContactLine> lines_, orderedLines_;  // per contact; the searched groups' lines, group by group

@@ -111,6 +111,9 @@ public:
 	// (searchLine). On by default; the results are bitwise the same (off for
 	// tests).
 	void setSolverReuse(bool reuse) { openClose_.setSolverReuse(reuse); }
+	// The last step's open-close iteration: its moving blocks and the system
+	// of its last solve (read only, for export).
+	const OpenCloseIteration& openClose() const { return openClose_; }
 	// Shi's w0 [m]: half the largest extent of the bounding box of the moving
 	// blocks (TimeStepControl::motionHalfSize), measured at the first step
 	// after blocks were added.

@@ -308,15 +308,17 @@ def account_drifts(start, energies, relative=1e-6, relative_to_change=1e-3):
     magnitude or `relative_to_change` x the largest change of any term since the
     start: a list of (step, drift [J], largest term [J], largest change [J]).
     Within the round-off of adding each step's terms to totals of that magnitude
-    (4 ulps a step) the account balances whatever the change: a mass at rest
-    changes by less than that."""
+    (4 ulps a step) and of summing the seven terms for the start and for the step
+    (half an ulp of a partial sum up to twice the magnitude per addition: 14 ulps)
+    the account balances whatever the change: a mass at rest changes by less than
+    that."""
     zero = account(start) - start['contactChanges']
     out = []
     for step, e in enumerate(energies, 1):
         drift = account(e) - e['contactChanges'] - zero
         magnitude = max(abs(v) for v in list(e.values()) + list(start.values()))
         change = largest(e, start)
-        roundoff = 4 * step * sys.float_info.epsilon * magnitude
+        roundoff = (4 * step + 14) * sys.float_info.epsilon * magnitude
         if abs(drift) > relative * magnitude or abs(drift) > max(relative_to_change * change, roundoff):
             out.append((step, drift, magnitude, change))
     return out
@@ -549,23 +551,27 @@ def test_one_and_two_threads_give_the_same_bits(scene, kind, seed, side, steps):
     velocities, are bitwise equal.
     (The narrow phase runs threaded at any size; the iterative solve's block
     rows from 128 blocks in one component, which the 7 m cube reaches: 155
-    free blocks; the loops over contacts from 2,048 contacts and over moving
-    blocks from 1,024, which only the 12 m orthogonal cube reaches: 1,452
-    free blocks, some 32,000 sub-contacts.)"""
+    free blocks, here with the coarse level from 64 blocks; the loops over
+    contacts from 2,048 contacts and over moving blocks from 1,024, which
+    only the 12 m orthogonal cube reaches: 1,452 free blocks, some 32,000
+    sub-contacts.)"""
     case = case_of(kind, seed, side)
     print(describe(case))
     runs = []
     for threads in (1, 2):
         O.reset()
-        ids, _, _ = R.build_scene(case, dt=DT, startFromRest=False, threads=threads)
-        seen, iterated = [], 0
+        coarse = dict(iterativeCoarseBlocks=64) if side == 7 else {}
+        ids, _, _ = R.build_scene(case, dt=DT, startFromRest=False, threads=threads, **coarse)
+        seen, iterated, aggregates = [], 0, 0
         for _ in range(steps):
             O.step()
             seen.append((blocks_bits(ids), bodies_bits()))
             iterated += yade_dda.stats()['iterativeComponents']
+            aggregates += yade_dda.stats()['coarseAggregates']
         runs.append(seen)
         if side >= 7:
             assert iterated > 0, '%s: the iterative solve was not taken' % describe(case)
+            assert aggregates > 0, '%s: the coarse level was not taken' % describe(case)
     for step, ((blocks1, bodies1), (blocks2, bodies2)) in enumerate(zip(*runs), 1):
         differ = [ids[k] for k, (x, y) in enumerate(zip(blocks1, blocks2)) if x != y]
         assert not differ, '%s: step %d, %d blocks differ on 1 and 2 threads (first body %d)' % (

@@ -62,3 +62,48 @@ def test_a_contact_closing_in_the_iteration_joins_the_system(scene):
     assert rebuilt and joined
     # The cubes bounced: they move apart at the end.
     assert yade_dda.block(a).velocity[0] < 0 < yade_dda.block(b).velocity[0]
+
+
+def test_the_exported_system_gives_the_step_its_motion(scene):
+    """yade_dda.coupledSystem() against the step it was taken from: two cubes
+    stacked on a fixed floor, released 0.1 mm apart with no start from rest,
+    so the contacts close and the stack compresses. At each step whose last
+    solve was taken whole (no line search), the exported K is symmetric and
+    positive definite, its rows are the two cubes joined by one link, and
+    the dense solution of K D = F moves each cube's centroid by exactly what
+    the step moved it (D's translation, to 1e-9 of the motion and the
+    centroid's round-off, 1e-15 m)."""
+    import numpy
+    rock = material(O, young=1e9)
+    floor = O.bodies.append(ddaBlock(box((-1, -1, -1), (2, 2, 0)), material=rock, fixed=True))
+    lower = O.bodies.append(ddaBlock(box((0, 0, 1e-4), (1, 1, 1 + 1e-4)), material=rock))
+    upper = O.bodies.append(ddaBlock(box((0, 0, 1 + 2e-4), (1, 1, 2 + 2e-4)), material=rock))
+    O.engines = [DDAIntegrator(dt=1e-3, gravity=(0, 0, -G), startFromRest=False)]
+    checked = 0
+    for _ in range(30):
+        before = {b: numpy.array(yade_dda.block(b).centroid) for b in (lower, upper)}
+        O.step()
+        s = yade_dda.stats()
+        system = yade_dda.coupledSystem()
+        if s['closedContacts'] == 0:
+            assert len(system['bodies']) == 0
+            continue
+        if s['lineSearches'] > 0 or s['largestComponent'] != 2:
+            continue
+        assert sorted(system['bodies']) == [lower, upper] and list(system['sizes']) == [12, 12]
+        assert system['links'].tolist() == [[0, 1]] and list(system['components']) == [0, 2]
+        K = numpy.zeros((24, 24))
+        for k, d in enumerate(system['diagonal']):
+            K[12 * k:12 * k + 12, 12 * k:12 * k + 12] = d
+        K[0:12, 12:24] = system['offDiagonal'][0]
+        K[12:24, 0:12] = system['offDiagonal'][0].T
+        assert numpy.array_equal(K, K.T)
+        assert numpy.linalg.eigvalsh(K)[0] > 0
+        D = numpy.linalg.solve(K, system['force'].ravel()).reshape(2, 12)
+        for row, body in enumerate(system['bodies']):
+            moved = numpy.array(yade_dda.block(body).centroid) - before[body]
+            assert numpy.allclose(system['centroids'][row], before[body], rtol=0, atol=1e-12)
+            assert numpy.abs(moved - D[row, :3]).max() <= 1e-9 * numpy.abs(moved).max() + 1e-15, (
+                'step %d, body %d: moved %s, the exported system gives %s' % (O.iter, body, moved, D[row, :3]))
+        checked += 1
+    assert checked >= 10, 'only %d steps were checked' % checked
