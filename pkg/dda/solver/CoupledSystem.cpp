@@ -231,7 +231,7 @@ std::size_t CoupledSystem::memoryBytes() const {
 	std::size_t kept = capacityBytes(analyses_) + capacityBytes(componentAnalysis_) + capacityBytes(componentHash_) +
 	                   analysisByHash_.size() * (sizeof(std::size_t) + sizeof(Analysis*) + 2 * sizeof(void*));
 	for (const AnalysisPtr& a : analyses_) kept += sizeof(Analysis) + capacityBytes(a->pattern) + a->bytes;
-	kept += iterative_.memoryBytes();
+	kept += iterative_.memoryBytes() + capacityBytes(slotCentroids_);
 	return capacityBytes(slot_) + capacityBytes(members_) + capacityBytes(unknowns_) + capacityBytes(componentStart_) +
 	       capacityBytes(diagonal_) + capacityBytes(force_) + capacityBytes(linkSlots_) + capacityBytes(linkStart_) +
 	       capacityBytes(offDiagonal_) + kept;

@@ -499,7 +499,7 @@ StepShrink OpenCloseIteration::smallestJacobian(const std::vector<Block>& blocks
 }
 
 std::size_t OpenCloseIteration::memoryBytes() const {
-	return coupled_.memoryBytes() + capacityBytes(moving_) + capacityBytes(movingIndex_) +
+	return coupled_.memoryBytes() + capacityBytes(moving_) + capacityBytes(movingIndex_) + capacityBytes(centroids_) +
 	       capacityBytes(solutions_) + capacityBytes(ownSystems_) + capacityBytes(ownSystemOf_) +
 	       capacityBytes(solvedAlone_) + capacityBytes(links_) + capacityBytes(hasSprings_) +
 	       capacityBytes(blockLimit_) + capacityBytes(blockUnknowns_) + capacityBytes(iterate_) +
