@@ -25,14 +25,18 @@ reference relative to its largest entry, setup time [ms] (partition, local
 matrices, communication plan, preconditioner), the solve's time and its time
 per iteration [ms] (median of --repeats solves; each figure the largest over
 the ranks), the shares of it in the halo exchange and in Allreduce (wall
-clock, the largest over the ranks), the compute imbalance, ghost rows and
-halo bytes sent per iteration per rank, and the speed-up over P = 1.
+clock, the largest over the ranks; both include waiting for the slower
+rank), the compute imbalance, each rank's CPU time over its wall time (below
+1 when another process took its core: the times are then not the solve's),
+ghost rows and halo bytes sent per iteration per rank, and the speed-up over
+P = 1.
 
 Writes bench/out/distributed_solve_<side>.npz (the saved systems) and
 bench/out/distributed_solve.json, and prints a table.
 Run: PYTHONPATH=<built package>/py /usr/bin/python3 bench/distributed_solve.py
 [--sides 11,14] [--procs 1,2] [--repeats 15] (about a minute a side at 11 and
-14 m, mostly the two steps). One part alone:
+14 m, mostly the two steps; 21 m takes about 6 minutes: 3 to step, 1 for the
+reference in each run). One part alone:
   ... distributed_solve.py --save FILE.npz --side 14        (needs YADE)
   mpirun -n 2 /usr/bin/python3 bench/distributed_solve.py --solve FILE.npz
 """
