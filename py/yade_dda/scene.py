@@ -554,9 +554,10 @@ def coupledSystem():
     (With rigid blocks, strike their strain rows and columns first.)
     """
     import numpy
-    raw = _require().core.coupledSystem()
+    scene = _require()
+    raw = scene.core.coupledSystem()
     n, m = raw['rows'], raw['links']
-    bodyOf = _require().bodyOfBlock
+    bodyOf = scene.bodyOfBlock
     blocks = numpy.frombuffer(raw['blocks'], dtype=numpy.int32)
     return dict(bodies=[int(bodyOf[b]) for b in blocks],
                 sizes=numpy.frombuffer(raw['sizes'], dtype=numpy.int32).copy(),
