@@ -39,6 +39,9 @@ GROUPS = (
      'back from `O.save`/`O.load`; keyword arguments only, as every YADE engine takes them.'),
     ('Scene functions', ('yade_dda.scene', 'yade.wrapper'),
      'The DDA state of the current YADE scene: diagnostics, block views, velocities, loads, contacts.'),
+    ('Ground shaking', ('yade_dda.shaking',),
+     'Prescribed motion of fixed blocks: an acceleration or velocity history (a table, a function or a '
+     'recorded accelerogram) that the contacts carry to the moving blocks.'),
     ('Save and load', ('yade_dda.saveload',),
      "YADE's own `O.save`/`O.load` carry the DDA state (see `O` above); these add crash-safe checkpoints."),
 )

@@ -105,7 +105,7 @@ void YadeSync::prepareBodies(const SceneLink& s, bool all, int threads) {
 		const Block& b = s.world.block(i);
 		const BodyLink* link = s.bodyLink(i);
 		const bool first = !link || !link->synced || resend_;  // a first write (or to objects new to this writer)
-		values.write = link && !(b.fixed && !first && !all);
+		values.write = link && !(b.fixed && !b.shaken && !first && !all);  // a still fixed block once
 		if (!values.write) continue;
 		// A part of a concave block: its own centroid, moving with its body.
 		const Block& moving = b.isPart() ? s.world.block(s.world.bodyOf(i)) : b;
@@ -158,7 +158,7 @@ int YadeSync::writeClumps(SceneLink& s, const py::object& bodies, bool all) {
 	for (const auto& [block, clump] : s.clumps()) {
 		const Block& b = s.world.block(block);
 		ClumpLink& link = *s.clumpLink(block);
-		if (b.fixed && link.synced && !resend_ && !all) continue;
+		if (b.fixed && !b.shaken && link.synced && !resend_ && !all) continue;
 		BodyObjects& objects = clumpObjects_[block];
 		if (objects.state.is_none()) objects = lookUp(bodies, clump.bodyId);
 		PyObject* state = objects.state.ptr();

@@ -19,6 +19,7 @@ namespace py = boost::python;
 using namespace dda;
 
 void registerSystemExport(py::class_<SceneLink, boost::noncopyable>& scene);  // pkg/py/SystemExport.cpp
+void registerBaseMotion(py::class_<SceneLink, boost::noncopyable>& scene);    // pkg/py/BaseMotion.cpp
 
 namespace {
 
@@ -270,6 +271,7 @@ py::dict lastStep(const SceneLink& s) {
 	energy["friction"] = account.friction;
 	energy["damping"] = account.damping;
 	energy["loads"] = account.loads;
+	energy["boundaryWork"] = account.boundaryWork;
 	energy["contactChanges"] = account.contactChanges;
 	d["energy"] = energy;
 	return d;
@@ -505,6 +507,7 @@ void registerScene() {
 	         "Replaces this scene by a state from saveState; ValueError naming the problem (and no change) if it cannot.");
 	registerConcaveBlocks(scene);
 	registerSystemExport(scene);
+	registerBaseMotion(scene);
 }
 
 // _core.YadeSync (pkg/py/YadeSync.hpp).

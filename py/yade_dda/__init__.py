@@ -27,6 +27,7 @@ from ._core import __version__  # noqa: F401  (CMakeLists.txt's project version)
 from .hooks import installHooks
 from .blocks import ddaBlock, rigidBlock, concaveBlock, boxCorners
 from .rockmass import cutRockMass
+from .shaking import baseMotion, baseMotionState, baseMotionRecord
 from .engines import DDAIntegrator
 from .colliders import MSCCollider, DESSCollider, NBSCollider, AllPairsCollider
 from .recorder import DDAVTKRecorder
@@ -42,7 +43,7 @@ _saveload.onLoad(_typedEngines)
 
 __all__ = ['ddaBlock', 'rigidBlock', 'concaveBlock', 'boxCorners', 'cutRockMass', 'DDAIntegrator', 'MSCCollider', 'DESSCollider', 'NBSCollider', 'AllPairsCollider',
            'Checkpoint', 'latestCheckpoint', 'DDAVTKRecorder', 'stats', 'printStats', 'sync', 'block', 'blockOf',
-           'setVelocity', 'addPointLoad', 'addFixedPoint', 'contacts', 'coupledSystem', 'Ig2_DDABlock_DDABlock_DDAContact', 'O']
+           'setVelocity', 'addPointLoad', 'addFixedPoint', 'baseMotion', 'baseMotionState', 'baseMotionRecord', 'contacts', 'coupledSystem', 'Ig2_DDABlock_DDABlock_DDAContact', 'O']
 
 _TOOLS = ('compareColliders', 'accuracySweep')
 """Tools of yade_dda.tools that are also names of the package: loaded on first use, out of ``import *``."""

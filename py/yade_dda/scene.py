@@ -340,9 +340,11 @@ _PYTHON_STATS = (
     ('energy', 'friction', 'J', 'dissipated by sliding (cumulative)'),
     ('energy', 'damping', 'J', 'dissipated by the time scheme, strain viscosity and velocityRatio < 1 (cumulative)'),
     ('energy', 'loads', 'J', 'work of point loads and fixed points (cumulative)'),
+    ('energy', 'boundaryWork', 'J', 'work done on the moving blocks by prescribed motions of fixed blocks '
+     '(baseMotion; cumulative)'),
     ('energy', 'contactChanges', 'J', "what the contacts' springs gained between steps: new penetrating contacts, "
      'gaps linearised again, springs lost when contacts vanish (cumulative). kinetic + gravity + strain + '
-     'contact + friction + damping - loads - contactChanges is conserved (doc/guide/reference.md, "The energy '
+     'contact + friction + damping - loads - boundaryWork - contactChanges is conserved (doc/guide/reference.md, "The energy '
      'account")'),
     ('memory', 'collider', 'bytes', "the broad phase's arrays (boxes, shells, grid, caches), after the detection"),
     ('memory', 'contacts', 'bytes', "the contact store, the previous step's contacts kept for their history"),
@@ -356,6 +358,7 @@ _PYTHON_STATS = (
     ('effects', 'fixedBlocks', '', 'blocks without unknowns (never paired together)'),
     ('effects', 'restingReuse', '', 'the broad phase was served from its pair cache'),
     ('effects', 'rigidBlocks', '', 'blocks with 6 unknowns'),
+    ('effects', 'baseMotion', '', 'a prescribed motion moved fixed blocks (baseMotion)'),
 )
 
 _STATS_GROUPS = (('', 'The step, its contacts and solves'),
@@ -420,6 +423,7 @@ def _effects(s):
         'fixedBlocks': s['fixedBlocks'],
         'restingReuse': bool(s['broadPhaseSkipped']),
         'rigidBlocks': s['rigidBlocks'],
+        'baseMotion': s['shakenBlocks'] > 0,
     }
 
 

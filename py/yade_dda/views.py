@@ -43,6 +43,7 @@ ENERGY_NAMES = (
     ('friction', 'ddaFriction', 1),              # cumulative, dissipated [J]
     ('damping', 'ddaDamping', 1),                # cumulative, dissipated [J]
     ('loads', 'ddaLoads', -1),                   # cumulative, minus the work of loads and fixed points [J]
+    ('boundaryWork', 'ddaBoundaryWork', -1),     # cumulative, minus the work of prescribed motions (baseMotion) [J]
     ('contactChanges', 'ddaContactChanges', -1),  # cumulative, minus what detection gave the springs [J]
 )
 

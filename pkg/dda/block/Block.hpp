@@ -72,7 +72,11 @@ struct Block {
 	// Elasticity matrix of the material [Pa]. Computed when asked (a dozen
 	// flops) rather than stored: 288 bytes per block, 14 MB on 50,000 blocks.
 	Matrix6 elasticity() const { return elasticityMatrix(material.young, material.poisson); }
-	bool fixed = false;  // a fixed block has no unknowns: it never moves
+	bool fixed = false;  // a fixed block has no unknowns: it never moves by the solve
+	// A fixed block that a prescribed motion translates (World::addBaseMotion,
+	// solver/BaseMotion.hpp): still no unknowns, its displacement over a step
+	// is known. Set by World from its motions; not saved with the block.
+	bool shaken = false;
 	// A rigid block has 6 unknowns (translation, rotation): no strain, no
 	// stress, no elastic term. Its strain unknowns and rates stay exactly zero
 	// in the 12-vector layout, so contact code needs no special case.

@@ -322,7 +322,7 @@ long MultiShellCover::updateShells(const std::vector<Block>& blocks) {
 	// shared among the step's threads (static chunks keep each thread's
 	// blocks consecutive, so the prefetch still runs ahead of it).
 	const int n = static_cast<int>(blocks.size());
-	const auto needsUpdate = [&](int b) { return !blocks[b].fixed || !covers_[b].boxesBuilt; };
+	const auto needsUpdate = [&](int b) { return !blocks[b].fixed || blocks[b].shaken || !covers_[b].boxesBuilt; };
 	resizeWithHeadroom(shellFixed_, shellBlock_.size());
 	long updates = 0;
 #pragma omp parallel for schedule(static, 256) reduction(+ : updates) if (n >= kMinBlocksForThreads)
@@ -393,7 +393,7 @@ int MultiShellCover::updateBoxes(const Block& block, BlockCover& cover, Frame& f
 		extentHigh_[s] = bounds[j].high;
 		frame.reach = std::max({frame.reach, bounds[j].low.cwiseAbs().maxCoeff(), bounds[j].high.cwiseAbs().maxCoeff()});
 	}
-	cover.boxesBuilt = block.fixed;
+	cover.boxesBuilt = block.fixed && !block.shaken;  // a shaken block's boxes move with it
 	return cover.shellCount;
 }
 

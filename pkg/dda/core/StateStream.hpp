@@ -116,6 +116,8 @@ public:
 		if (std::memcmp(data_ + pos_, name, 4) != 0) fail(std::string("section '") + name + "' not found where expected");
 		pos_ += 4;
 	}
+	// Whether the next section is `name` (an optional one), without reading.
+	bool nextTag(const char (&name)[5]) const { return size_ - pos_ >= 4 && std::memcmp(data_ + pos_, name, 4) == 0; }
 	// An index read from the state must lie in [0, count).
 	int index(int count, const char* what) {
 		const int i = pod<int>();

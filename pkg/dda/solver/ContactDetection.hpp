@@ -48,6 +48,10 @@ public:
 	// Faces of fixed blocks covered by a flush neighbour, per block (empty for
 	// a moving block); as the last detection left them.
 	const std::vector<std::vector<char>>& internalFaces() const { return internalFaces_; }
+	// Some fixed blocks moved and others did not (a prescribed motion of a
+	// part of them, World::addBaseMotion): faces that were flush may be no
+	// longer, so the next detection finds the flush faces and covers again.
+	void fixedBlocksMoved() { internalFacesBlocks_ = coverDepthsBlocks_ = -1; }
 	// Saving (World::writeState / readState): the flush-joint faces and the
 	// block count they were computed for.
 	void writeState(StateWriter& out) const;

@@ -274,6 +274,7 @@ struct ContactStepEnergy {
 	double end = 0;       // spring energy at the step's solution [J]
 	double damping = 0;   // the springs' Bregman divergence (>= 0) [J]
 	double friction = 0;  // dissipated by slip [J]
+	double boundary = 0;  // work of a prescribed motion of its fixed side on the moving side [J] (World)
 };
 ContactStepEnergy contactStepEnergy(const Contact& contact, const Block& blockI, const Block& blockJ,
                                     const Vector12& Di, const Vector12& Dj);

@@ -82,15 +82,16 @@ void World::accountStep(const IntegratorSettings& settings, double dt) {
 			energy_.loads += stiffness * (point.anchor - point.position - gamma * u).dot(u);
 		}
 	}
-	accountContacts();
+	accountContacts(gamma);
 }
 
-void World::accountContacts() {
+void World::accountContacts(double gamma) {
 	// Contacts: their springs' energy at the start of this step in the
 	// accepted states against what the last step ended with. Each contact's
 	// terms are computed on any thread, then summed in contact order.
 	const std::vector<Contact>& contacts = store_.contacts();
 	const int contactCount = static_cast<int>(contacts.size());
+	const bool shaking = this->shaking();
 	contactEnergies_.resize(contacts.size());
 #pragma omp parallel for schedule(static) if (contactCount >= kMinContactsForThreads)
 	for (int c = 0; c < contactCount; ++c) {
@@ -98,6 +99,8 @@ void World::accountContacts() {
 		const int bi = contact.bodyI, bj = contact.bodyJ;
 		contactEnergies_[c] = contactStepEnergy(contact, blocks_[bi], blocks_[bj], openClose_.solutionOf(bi),
 		                                        openClose_.solutionOf(bj));
+		// A prescribed motion's work through the contact (PrescribedMotion.cpp).
+		if (shaking) contactEnergies_[c].boundary = boundaryWork(contact, gamma);
 	}
 	double start = 0, end = 0;
 	for (const ContactStepEnergy& e : contactEnergies_) {
@@ -105,6 +108,7 @@ void World::accountContacts() {
 		end += e.end;
 		energy_.damping += e.damping;
 		energy_.friction += e.friction;
+		energy_.boundaryWork += e.boundary;
 	}
 	energy_.contactChanges += start - energy_.contact;
 	energy_.contact = end;

@@ -34,6 +34,7 @@ struct EnergyAccount {
 	double friction = 0;  // dissipated by sliding (work of friction loads against the relative motion)
 	double damping = 0;   // dissipated by the time scheme, the strain viscosity and velocityRatio < 1
 	double loads = 0;     // work done on the blocks by point loads and fixed-point springs
+	double boundaryWork = 0;  // work done on the moving blocks by prescribed motions of fixed blocks (BaseMotion.hpp)
 	// Energy the contacts' springs gained between the end of one step and the
 	// start of the next (D = 0 of the next step in its accepted states): new
 	// contacts found penetrating, gaps linearised again from the moved

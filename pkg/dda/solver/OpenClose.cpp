@@ -80,7 +80,8 @@ void OpenCloseIteration::selectMovingBlocks(const std::vector<Block>& blocks, co
 const Vector12& OpenCloseIteration::solutionOf(int block) const {
 	static const Vector12 zero = Vector12::Zero();
 	const int k = movingIndex_[block];
-	return k < 0 ? zero : iterate_[k];
+	if (k >= 0) return iterate_[k];
+	return prescribed_ ? (*prescribed_)[block] : zero;
 }
 
 bool OpenCloseIteration::solve(const std::vector<Block>& blocks, std::vector<Contact>& contacts,
@@ -154,10 +155,12 @@ void OpenCloseIteration::startAttempt(const Attempt& attempt, bool firstStep) {
 		const Block& blockJ = attempt.blocks[contact.bodyJ];
 		// The first pass's limit from the normal force at the start of
 		// the step (its gap now), not the one the contact ended the last
-		// step with: a corner that bounced off keeps no friction.
-		evaluateContact(contact, blockI, blockJ, solutionOf(contact.bodyI), solutionOf(contact.bodyJ));
+		// step with: a corner that bounced off keeps no friction. At D = 0
+		// on both sides (a prescribed motion's block too: the start).
+		static const Vector12 start = Vector12::Zero();
+		evaluateContact(contact, blockI, blockJ, start, start);
 		updateFrictionLimit(contact, true);
-		evaluateContact(contact, blockI, blockJ, solutionOf(contact.bodyI), solutionOf(contact.bodyJ));
+		evaluateContact(contact, blockI, blockJ, start, start);
 	}
 	computeStartAccelerations(attempt);
 	// The blocks that contacts join (open ones too: their energy counts

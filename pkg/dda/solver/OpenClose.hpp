@@ -42,8 +42,17 @@ public:
 	           double dt, bool firstStep, StepStatistics& stats);
 	// The accepted solution of moving block k (an index of moving()).
 	const Vector12& solution(int k) const { return solutions_[k]; }
-	// A block's entry of the current iterate; zero for fixed blocks.
+	// A block's entry of the current iterate; for a fixed block its known
+	// displacement (setPrescribed), else zero.
 	const Vector12& solutionOf(int block) const;
+	// The known displacement of each block over the attempts' dt (indexed
+	// by block; a moving block's entry is not read), or nullptr: fixed blocks
+	// stay. A fixed block with a prescribed motion (BaseMotion.hpp) has no
+	// unknowns; its contacts with moving blocks take its displacement as a
+	// known gap and stretch change (addKnownDisplacement). World sets it
+	// for each attempt.
+	void setPrescribed(const std::vector<Vector12>* prescribed) { prescribed_ = prescribed; }
+	bool prescribed() const { return prescribed_ != nullptr; }
 	// Largest vertex displacement of the last attempt [m].
 	double largestDisplacement(const std::vector<Block>& blocks) const;
 	// The moving blocks (block indices, ascending) whose corners the last
@@ -115,6 +124,12 @@ private:
 	void solveAloneBlocks(const Attempt& attempt);
 	// Adds the trial-state terms of every contact to coupled_ (counted in stats).
 	void assembleContacts(const Attempt& attempt);
+	// A contact's energy is a function of (D_i, D_j); with the displacement
+	// of its fixed side known (prescribed_), the moving side's Newton model
+	// K_ii D_i = F_i takes the known part to the right-hand side:
+	// F_i -= K_ij D_j, term by term (K = sum_r w_r v_r v_r^T).
+	void addKnownDisplacement(const ContactTerms& terms, int mi, int mj, int bi, int bj);
+	const std::vector<Vector12>* prescribed_ = nullptr;
 	// Within an attempt a contact's Newton terms (contactTerms) depend on its
 	// state alone unless it slips or carries a secant force: the normal
 	// spring's on the start-of-step linearisation, the stick spring's on the

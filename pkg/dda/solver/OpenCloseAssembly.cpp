@@ -148,7 +148,20 @@ void OpenCloseIteration::assembleContacts(const Attempt& attempt) {
 		}
 		if (diagonalI) coupled_.force(mi) += terms.force.head<12>();
 		if (diagonalJ) coupled_.force(mj) += terms.force.tail<12>();
+		if (prescribed_ && (mi < 0 || mj < 0)) addKnownDisplacement(terms, mi, mj, bi, bj);
 	}
+}
+
+void OpenCloseIteration::addKnownDisplacement(const ContactTerms& terms, int mi, int mj, int bi, int bj) {
+	// The moving side (offset 0 for i, 12 for j) and the known side's D.
+	const bool iMoves = mi >= 0;
+	if (iMoves == (mj >= 0)) return;
+	const Vector12& known = (*prescribed_)[iMoves ? bj : bi];
+	if (known.isZero()) return;
+	const int own = iMoves ? 0 : 12, other = iMoves ? 12 : 0;
+	Vector12& force = coupled_.force(iMoves ? mi : mj);
+	for (int r = 0; r < terms.rank; ++r)
+		force -= (terms.weight[r] * terms.vector[r].segment<12>(other).dot(known)) * terms.vector[r].segment<12>(own);
 }
 
 }  // namespace dda

@@ -240,6 +240,9 @@ double World::advance(const IntegratorSettings& settings) {
 	openClose_.selectMovingBlocks(blocks_, frozen_, stats);
 	if (settling_) dropFrozenContacts(stats);
 	stats.staticAnalysis = settings.velocityRatio == 0;
+	openClose_.setPrescribed(shaking() ? &prescribed_ : nullptr);
+	if (shaking())
+		for (const ShakenGroup& group : baseMotions_) stats.shakenBlocks += static_cast<int>(group.blocks.size());
 	const double dt = solveStep(settings, stats);
 
 	gravity_ = settings.gravity;
@@ -261,8 +264,12 @@ double World::solveStep(const IntegratorSettings& settings, StepStatistics& stat
 	std::vector<Contact>& contacts = store_.contacts();
 	double dt = timeStep_.firstTry(settings);
 	for (int attempt = 0;; ++attempt) {
+		// The shaken blocks' displacement over this attempt's dt (a cut step
+		// takes its own), part of the step's largest.
+		if (shaking()) prescribeMotions(dt);
 		const bool converged = openClose_.solve(blocks_, contacts, settings, dt, steps_ == 0, stats);
-		const double largest = openClose_.largestDisplacement(blocks_);
+		double largest = openClose_.largestDisplacement(blocks_);
+		if (shaking()) largest = std::max(largest, prescribedLargest_);
 		if (!std::isfinite(largest)) {
 			std::ostringstream message;
 			message << "the DDA step produced a non-finite displacement (dt = " << dt << " s)";
@@ -288,6 +295,7 @@ void World::moveContactsAndBlocks(const IntegratorSettings& settings, double dt,
 	// a -0 never replaces it), so any split over threads gives the same.
 	std::vector<Contact>& contacts = store_.contacts();
 	const int contactCount = static_cast<int>(contacts.size());
+	const bool shaking = this->shaking();
 	long closedCount = 0, slidingCount = 0, bondedCount = 0;
 	double deepest = stats.maxPenetration;
 #pragma omp parallel if (contactCount >= kMinContactsForThreads)
@@ -304,9 +312,12 @@ void World::moveContactsAndBlocks(const IntegratorSettings& settings, double dt,
 			finishContact(contact, blocks_[bi], blocks_[bj], Di, Dj);
 			ContactHistory& trial = contact.trial;
 			contact.point = mi >= 0 ? motions_[mi](contact.geometry.pointI) : contact.geometry.pointI;
+			if (shaking && blocks_[bi].shaken) contact.point += Di.head<3>();  // its known translation
 			if (trial.state != ContactState::Open) {
 				if (mi >= 0) trial.anchorI = motions_[mi](trial.anchorI);
 				if (mj >= 0) trial.anchorJ = motions_[mj](trial.anchorJ);
+				if (shaking && blocks_[bi].shaken) trial.anchorI += Di.head<3>();
+				if (shaking && blocks_[bj].shaken) trial.anchorJ += Dj.head<3>();
 				++closedHere;
 				slidingHere += trial.state == ContactState::Sliding;
 				deepestHere = std::max(deepestHere, -contactGap(contact, Di, Dj));
@@ -334,6 +345,7 @@ void World::moveContactsAndBlocks(const IntegratorSettings& settings, double dt,
 		for (int p = 1; p < block.partCount; ++p)
 			movePart(blocks_[moving[k] + p], block, motions_[k], openClose_.solution(k));
 	}
+	if (shaking) moveShakenBlocks(dt);
 	stats.timeUpdate = secondsSince(phase);
 }
 

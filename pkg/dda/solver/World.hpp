@@ -2,6 +2,7 @@
 // One World per YADE scene; the Python side maps YADE body ids to block indices.
 #pragma once
 
+#include "BaseMotion.hpp"
 #include "BlockEquations.hpp"
 #include "ContactDetection.hpp"
 #include "ContactEquations.hpp"
@@ -69,6 +70,17 @@ public:
 	void addPointLoad(int index, const Vector3& position, const Vector3& force);
 	void setVelocity(int index, const Vector3& velocity, const Vector3& angularVelocity);
 	void setStress(int index, const Vector6& stress);
+	// A prescribed translation (BaseMotion.hpp) of the fixed blocks
+	// `indices` (a concave block with all its parts); returns the motion's
+	// index. Throws InputError naming the block: an index out of range, a
+	// block that is not fixed, one given twice or that has a motion already.
+	// The blocks move from the first dynamic step on (never while settling:
+	// start from rest holds them where they are). PrescribedMotion.cpp.
+	int addBaseMotion(const std::vector<int>& indices, BaseMotion motion);
+	int baseMotionCount() const { return static_cast<int>(baseMotions_.size()); }
+	const BaseMotion& baseMotion(int motion) const;
+	// The blocks (parts) a motion moves, ascending.
+	const std::vector<int>& baseMotionBlocks(int motion) const;
 
 	// Advances all blocks by one accepted step; returns the dt taken [s].
 	// The first step starts from rest (settle) when settings ask for it.
@@ -173,13 +185,44 @@ private:
 	bool settleConverged_ = false;
 	std::vector<int> unsettled_;  // see unsettledBlocks()
 
+	// Prescribed motions (PrescribedMotion.cpp): each with its blocks.
+	struct ShakenGroup {
+		BaseMotion motion;
+		std::vector<int> blocks;
+	};
+	std::vector<ShakenGroup> baseMotions_;
+	// Per block, its known displacement over the attempt [time_, time_ + dt]
+	// (zero for blocks without a motion), and the largest translation among
+	// them [m]; filled only when the step has motions (shaking()).
+	std::vector<Vector12> prescribed_;
+	double prescribedLargest_ = 0;
+	bool shakeAll_ = false;  // every fixed block has a motion (their flush faces stay flush)
+	// Whether this step moves the shaken blocks: there are motions, and it
+	// is no static step of the start from rest.
+	bool shaking() const { return !baseMotions_.empty() && !settling_; }
+	void prescribeMotions(double dt);
+	// After an accepted step: the shaken blocks (and their parts) translated
+	// by their known displacement, their velocity the motion's at the end.
+	void moveShakenBlocks(double dt);
+	// The work [J] a contact's known side does on its moving side over the
+	// accepted step: -gamma f_j . D_j, f_j the force on the known side of the
+	// solve's model (F - K D), gamma the scheme's (its mean force).
+	double boundaryWork(const Contact& contact, double gamma) const;
+	// The shaken flags of the blocks from baseMotions_ (after a load).
+	void markShakenBlocks();
+	// Saving (WorldState.cpp): the motions, their blocks and the work done;
+	// reading them sets the blocks' shaken flags.
+	void writeBaseMotions(StateWriter& out) const;
+	void readBaseMotions(StateReader& in);
+
 	// Adds the accepted step's dissipation, work of loads and contact springs'
 	// changes to the account (energy_), and records the springs' energy at its
 	// end; called before the contacts and blocks are moved (EnergyAccount.cpp).
 	void accountStep(const IntegratorSettings& settings, double dt);
-	// accountStep's contact part: contactChanges, the springs' energy, and
-	// the contacts' damping and friction.
-	void accountContacts();
+	// accountStep's contact part: contactChanges, the springs' energy, the
+	// contacts' damping and friction, and the work of prescribed motions
+	// (gamma: the scheme's, IntegratorSettings::newmarkGamma).
+	void accountContacts(double gamma);
 
 	std::unique_ptr<Collider> collider_ = std::make_unique<DESSCollider>();
 	ContactStore store_;

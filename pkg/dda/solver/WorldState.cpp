@@ -282,6 +282,7 @@ void World::writeState(StateWriter& out) const {
 		out.pod(e.feature);
 		out.pod(e.other);
 	}
+	writeBaseMotions(out);
 	out.tag("END.");
 }
 
@@ -354,6 +355,7 @@ void World::readState(StateReader& in) {
 		entrances.emplace(key, e);
 	}
 	w.store_.restore(std::move(contacts), std::move(entrances));
+	w.readBaseMotions(in);
 	in.tag("END.");
 	*this = std::move(w);
 }

@@ -13,7 +13,7 @@ import yade_dda
 PACKAGE = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', '..', 'py', 'yade_dda')
 COMPILED = ('_core',)   # the C++ module, built from pkg/dda: imports no Python sibling
 SCENE_API = ('__init__', '_yade', 'blocks', 'colliders', 'engines', 'guards', 'hooks', 'params', 'recorder',
-             'rockmass', 'saveload', 'scene', 'state', 'typedengines', 'views')
+             'rockmass', 'saveload', 'scene', 'shaking', 'state', 'typedengines', 'views')
 """The modules of the top level of py/yade_dda: what a scene script imports."""
 TOOLS = ('__init__', 'accuracy', 'compare', 'regression', 'sweep')
 """The modules of py/yade_dda/tools: the workflow tools."""

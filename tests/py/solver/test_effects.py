@@ -58,7 +58,7 @@ def test_no_gravity_no_body_force_and_static_analysis(scene):
     assert s['bodyForceBlocks'] == 0
     assert s['effects'] == {'friction': False, 'gravity': False, 'static': False, 'bonds': False,
                             'fixedBlocks': 0, 'restingReuse': s['effects']['restingReuse'], 'rigidBlocks':
-                            s.get('rigidBlocks', 0)}
+                            s.get('rigidBlocks', 0), 'baseMotion': False}
     assert abs(O.bodies[body].state.pos[0] - (0.5 + 0.5 * O.time)) < 1e-12   # x = x0 + v t
     # Shi's static analysis is velocityRatio=0: velocities do not carry over,
     # so the unloaded block stays where it is.
