@@ -8,6 +8,8 @@ latter as plain numbers for ``yade.plot.addData``). The kinematics are exact wit
 ``boundaryWork``.
 """
 import math
+import numbers
+import os
 
 from .scene import current
 
@@ -123,8 +125,8 @@ def _finite(value, what):
 
 def _table(history, kind, sampling, duration):
     """(times, values) of a table, a file or a callable."""
-    if isinstance(history, str):
-        return readMotionFile(history)
+    if isinstance(history, (str, os.PathLike)):
+        return readMotionFile(os.fspath(history))
     if callable(history):
         if sampling is None or duration is None:
             raise ValueError('a %s given as a function needs sampling= and duration= [s] to tabulate it' % kind)
@@ -185,7 +187,7 @@ def _vectors(values, direction, scale, kind):
         unit = [x / norm for x in d]
     out = []
     for k, value in enumerate(values):
-        if isinstance(value, (int, float)) and not isinstance(value, bool):
+        if isinstance(value, numbers.Real) and not isinstance(value, bool):
             along = unit or (1.0, 0.0, 0.0)
             out.append(tuple(scale * float(value) * x for x in along))
             continue

@@ -329,4 +329,4 @@ def rest_account(free):
     import yade_dda
     gravity = math.fsum(yade_dda.block(i).mass * G * yade_dda.block(i).centroid[2] for i in free)
     return dict(kinetic=0.0, gravity=gravity, gravityChange=0.0, strain=0.0, contact=0.0, friction=0.0, damping=0.0,
-                loads=0.0, contactChanges=0.0)
+                loads=0.0, boundaryWork=0.0, contactChanges=0.0)

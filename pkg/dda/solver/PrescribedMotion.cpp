@@ -47,7 +47,6 @@ void World::markShakenBlocks() {
 	for (Block& block : blocks_) block.shaken = false;
 	for (const ShakenGroup& group : baseMotions_)
 		for (const int b : group.blocks) blocks_[b].shaken = true;
-	shakeAll_ = std::none_of(blocks_.begin(), blocks_.end(), [](const Block& b) { return b.fixed && !b.shaken; });
 }
 
 void World::prescribeMotions(double dt) {
@@ -71,8 +70,10 @@ void World::moveShakenBlocks(double dt) {
 			block.velocity.head<3>() = velocity;
 		}
 	}
-	// Flush faces between a shaken and a still fixed block part.
-	if (!shakeAll_) detection_.fixedBlocksMoved();
+	// Faces that were flush between a shaken and a still fixed block (part)
+	// may be no longer (blocks added since the motions count too).
+	if (std::any_of(blocks_.begin(), blocks_.end(), [](const Block& b) { return b.fixed && !b.shaken; }))
+		detection_.fixedBlocksMoved();
 }
 
 double World::boundaryWork(const Contact& contact, double gamma) const {

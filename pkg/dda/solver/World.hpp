@@ -196,7 +196,6 @@ private:
 	// them [m]; filled only when the step has motions (shaking()).
 	std::vector<Vector12> prescribed_;
 	double prescribedLargest_ = 0;
-	bool shakeAll_ = false;  // every fixed block has a motion (their flush faces stay flush)
 	// Whether this step moves the shaken blocks: there are motions, and it
 	// is no static step of the start from rest.
 	bool shaking() const { return !baseMotions_.empty() && !settling_; }

@@ -93,12 +93,13 @@ def linear(times, values):
     return f
 
 
-def shaken_incline(phiDeg, size=(1.0, 1.0, 0.4)):
-    """A fixed slab whose top is a plane dipping ALPHA towards +x, a rigid block on it; (slab, block, downhill)."""
+def shaken_incline(phiDeg, size=(1.0, 1.0, 0.4), rigid=True):
+    """A fixed slab whose top is a plane dipping ALPHA towards +x, a block on it (rigid unless told);
+    (slab, block, downhill)."""
     geo = S.incline_geometry(ALPHA, size, slab=((-3.0, -1.5, -1.0), (4.0, 1.5, 0.0)))
     rock = S.rock(phiDeg)
     slab = O.bodies.append(ddaBlock(geo['slab'], material=rock, fixed=True))
-    block = O.bodies.append(rigidBlock(geo['block'], material=rock))
+    block = O.bodies.append(ddaBlock(geo['block'], material=rock, rigid=rigid))
     return slab, block, geo['frame'][0]
 
 
@@ -127,21 +128,24 @@ def slip_until(slab, block, downhill, t_end):
     return sum(relative[i] * downhill[i] for i in range(3))
 
 
-def test_sinusoid_slip_is_newmarks_closed_form(scene):
+@pytest.mark.parametrize('rigid', [True, False], ids=['rigid', 'deformable'])
+def test_sinusoid_slip_is_newmarks_closed_form(scene, rigid):
     """2 cycles of 0.5 g at 2 Hz, alpha 20 deg, phi 30 deg (a_y = 0.176 g): DDA's slip within
-    2 % of the closed form; the numerical reference agrees with it to 1e-4."""
+    2 % of the closed form, for a rigid block and a deformable one (E 1e10 Pa: its strain under
+    the shaking is 1e-6); the numerical reference agrees with the closed form to 1e-4."""
     phi, A, w, cycles = math.radians(30.0), 0.5 * G, 4 * math.pi, 2
     ay, k = newmark_constants(phi)
     expected, t2 = newmark_sine_slip(A, w, ay, k, cycles)
     numeric = newmark_numeric(lambda t: A * math.sin(w * t), cycles * 2 * math.pi / w, ay, k)
     assert abs(numeric - expected) < 1e-4 * expected, (numeric, expected)
-    slab, block, downhill = shaken_incline(30.0)
+    slab, block, downhill = shaken_incline(30.0, rigid=rigid)
     baseMotion(slab, acceleration=lambda t: A * math.sin(w * t), direction=UPHILL, sampling=1e-3,
                duration=cycles * 2 * math.pi / w)
     O.engines = [integrator()]
     slip = slip_until(slab, block, downhill, cycles * 2 * math.pi / w)
     error = (slip - expected) / expected
-    print('sinusoid: slip %.6f m, Newmark %.6f m (t2 %.4f s), error %+.3f %%' % (slip, expected, t2, 100 * error))
+    print('sinusoid (%s): slip %.6f m, Newmark %.6f m (t2 %.4f s), error %+.3f %%'
+          % ('rigid' if rigid else 'deformable', slip, expected, t2, 100 * error))
     assert abs(error) < 0.02
     assert stats()['effects']['baseMotion'] is True and stats()['shakenBlocks'] == 1
 
@@ -176,7 +180,7 @@ def test_recorded_accelerogram_slip_is_newmarks_integration(scene, tmp_path):
     end = times[-1] + 0.3
     expected = newmark_numeric(linear(times, values), end, ay, k)
     slab, block, downhill = shaken_incline(30.0)
-    baseMotion(slab, acceleration=path, direction=UPHILL)
+    baseMotion(slab, acceleration=tmp_path / 'record.txt', direction=UPHILL)   # a str or a path
     O.engines = [integrator()]
     slip = slip_until(slab, block, downhill, end)
     error = (slip - expected) / expected
@@ -414,3 +418,38 @@ def test_a_shaken_blocks_corners_push_a_free_block(scene):
     print('pusher: work %.6f J, kinetic %.6f J, damping %.3e J' % (e['boundaryWork'], e['kinetic'], e['damping']))
     assert abs(e['boundaryWork'] - (e['kinetic'] + e['contact'] + e['damping'] - e['contactChanges'])) \
         < 1e-10 * e['boundaryWork']
+
+
+# (slope alpha [deg], phi [deg], peak [g], frequency [Hz], cycles, direction: 'horizontal' or 'along')
+SWEEP = [(10.0, 35.0, 0.5, 1.0, 1, 'horizontal'), (25.0, 35.0, 0.35, 3.0, 3, 'horizontal'),
+         (15.0, 25.0, 0.6, 2.0, 2, 'along'), (30.0, 38.0, 0.25, 1.5, 2, 'along')]
+
+
+@pytest.mark.parametrize('alphaDeg, phiDeg, peak, hz, cycles, direction', SWEEP,
+                         ids=['%g-%g-%gg-%ghz-%s' % (a, p, g, f, d) for a, p, g, f, c, d in SWEEP])
+def test_newmark_over_slopes_frequencies_and_directions(scene, alphaDeg, phiDeg, peak, hz, cycles, direction):
+    """Newmark's closed form for the sinusoid over other slopes, friction angles, peaks and
+    frequencies, horizontal and along-slope shaking, within 2 %. Along the slope (the base
+    accelerating uphill along it by a(t)) the normal force is g cos(alpha) whatever a(t), so
+    a_y = g (tan(phi) cos(alpha) - sin(alpha)) and k = 1 (the module's derivation with the
+    direction's normal component 0)."""
+    alpha, phi = math.radians(alphaDeg), math.radians(phiDeg)
+    A, w = peak * G, 2 * math.pi * hz
+    if direction == 'horizontal':
+        (ay, k), along = newmark_constants(phi, alpha), UPHILL
+    else:
+        ay, k = G * (math.tan(phi) * math.cos(alpha) - math.sin(alpha)), 1.0
+        along = (-math.cos(alpha), 0.0, math.sin(alpha))
+    expected, _ = newmark_sine_slip(A, w, ay, k, cycles)
+    geo = S.incline_geometry(alpha, (1.0, 1.0, 0.4), slab=((-3.0, -1.5, -1.0), (4.0, 1.5, 0.0)))
+    rock = S.rock(phiDeg)
+    slab = O.bodies.append(ddaBlock(geo['slab'], material=rock, fixed=True))
+    block = O.bodies.append(rigidBlock(geo['block'], material=rock))
+    baseMotion(slab, acceleration=lambda t: A * math.sin(w * t), direction=along, sampling=1e-3,
+               duration=cycles / hz)
+    O.engines = [integrator()]
+    slip = slip_until(slab, block, geo['frame'][0], cycles / hz)
+    error = (slip - expected) / expected
+    print('alpha %g phi %g %g g %g Hz %s: slip %.6f m, Newmark %.6f m, error %+.3f %%'
+          % (alphaDeg, phiDeg, peak, hz, direction, slip, expected, 100 * error))
+    assert abs(error) < 0.02
