@@ -4,7 +4,7 @@ Seeded confined masses of tests/py/rockmass_scenes.py (a cube cut by three
 joint sets at 1 m, the blocks touching its sides or base held, E = 1e9 Pa,
 friction 35 deg above every joint's dip), started from rest (the default) and
 run for a given time at dt = 1e-3 s on one thread. Per case: blocks, free
-blocks, the start from rest (static steps, converged, the blocks it could not
+blocks, the start from rest (static steps, open-close solves, converged, the blocks it could not
 hold, its wall time), then per step the mean and largest open-close solves and
 friction-limit passes, step cuts, the mean wall time and
 its phases (narrow phase, assembly, solve), the free blocks' largest speed at
@@ -66,7 +66,8 @@ def run_case(name, duration, settings=None):
         solve += s['time']['solve']
     n = len(solves)
     return dict(case=name, description=R.describe(case), blocks=len(ids), free=len(free),
-                settleSteps=first['settleSteps'], settleConverged=bool(first['settleConverged']),
+                settleSteps=first['settleSteps'], settleSolves=first['settleSolves'],
+                settleConverged=bool(first['settleConverged']),
                 unsettled=len(first['unsettledBlocks']),
                 settleSeconds=settle, steps=n, meanSolves=sum(solves) / n, mostSolves=max(solves), meanPasses=passes / n, stepCuts=cuts,
                 msPerStep=1e3 * wall / n, msNarrowPhase=1e3 * narrow / n, msAssembly=1e3 * assembly / n,
@@ -96,10 +97,10 @@ def main():
             raise SystemExit('case %s wrote no result' % name)
         rows.append(json.loads(line[0][7:]))
         r = rows[-1]
-        print('%-14s %5d blocks %4d free  settle %2d steps %-5s unsettled %d %6.1f s | %4d steps  solves %5.2f '
+        print('%-14s %5d blocks %4d free  settle %2d steps %5d solves %-5s unsettled %d %6.1f s | %4d steps  solves %5.2f '
               '(most %2d)  passes %.2f  cuts %d  '
               '%7.1f ms/step (narrow %.1f, assembly %.1f, solve %.1f)  speed %.2e m/s  contact changes %.2e J'
-              % (r['case'], r['blocks'], r['free'], r['settleSteps'], r['settleConverged'], r['unsettled'],
+              % (r['case'], r['blocks'], r['free'], r['settleSteps'], r['settleSolves'], r['settleConverged'], r['unsettled'],
                  r['settleSeconds'], r['steps'], r['meanSolves'], r['mostSolves'], r['meanPasses'], r['stepCuts'], r['msPerStep'], r['msNarrowPhase'],
                  r['msAssembly'], r['msSolve'], r['largestSpeed'], r['contactChanges']), flush=True)
     os.makedirs(os.path.join(HERE, 'out'), exist_ok=True)

@@ -438,6 +438,42 @@ def test_a_confined_mass_settles_and_stays_at_rest(scene, kind, seed, side, dura
             describe(case), first['settleSolves'], first['settleSteps']))
 
 
+# The settled state is an equilibrium: the first step starts every block at rest, so a block's speed
+# at its end is its out-of-balance acceleration at the settled state times dt (reactions that build
+# within the step only resist). The settling's quiet test admits 1e-4 g (kSettleQuietAcceleration);
+# this bound is 50 times looser, for contacts that close within the step. Seed 2 of the 6 m oblique
+# mass ended a settling whose static steps kept friction on contacts that had opened with a block
+# 0.18 g out of balance; seed 1 of the 5 m one, settled with no final passes that settle the limits
+# within a step, 8.7e-3 g. The cost bound is the one above: with their limits settled pass by pass
+# in every static step, the true friction's steps made 80 solves each (seed 2, 6 m).
+UNBALANCED = 5e-3    # [g]
+BALANCE_RUNS = ([('oblique', 2, 6.0), ('oblique', 1, 5.0)]
+                + [pytest.param('oblique', 1, 7.0, marks=pytest.mark.slow),
+                   pytest.param('oblique', 1, 9.0, marks=[pytest.mark.slow, pytest.mark.xfail(
+                       strict=False, reason='a 3.2 t block starts 1e-2 g out of balance (the quiet test is '
+                       'relative to the largest first move) and comes to rest within 0.1 s')])])
+
+
+@pytest.mark.parametrize('kind, seed, side', BALANCE_RUNS)
+def test_the_settled_state_leaves_no_block_out_of_balance(scene, kind, seed, side):
+    O.reset()
+    case = case_of(kind, seed, side)
+    _, _, free = R.build_scene(case, dt=DT)
+    O.step()
+    first = yade_dda.stats()
+    speed, body = max((O.bodies[i].state.vel.norm(), i) for i in free)
+    print(describe(case), 'settle steps', first['settleSteps'], 'solves', first['settleSolves'],
+          'first step: largest speed %.3g m/s (body %d)' % (speed, body))
+    O.reset()
+    assert first['settleConverged'], describe(case)
+    assert first['settleSolves'] <= SETTLE_SOLVES_PER_STEP * first['settleSteps'], (
+        '%s: start from rest made %d open-close solves in %d static steps' % (
+            describe(case), first['settleSolves'], first['settleSteps']))
+    assert speed <= UNBALANCED * R.G * DT, (
+        '%s: body %d at %.3g m/s after the first step: %.3g g out of balance at the settled state'
+        % (describe(case), body, speed, speed / (R.G * DT)))
+
+
 @pytest.mark.parametrize('kind, seed, side, duration', REST_RUNS)
 def test_a_settled_mass_keeps_its_energy_account(scene, kind, seed, side, duration):
     case, first, _, energies, _, _, _ = rest_run(kind, seed, side, duration)
