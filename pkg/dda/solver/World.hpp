@@ -178,7 +178,7 @@ private:
 	void lockSettledContacts();
 	std::vector<char> frozen_;   // per block while settling, else empty
 	bool settling_ = false;
-	bool polishing_ = false;
+	bool polishing_ = false;     // the final static steps with their passes (admitFriction)
 	double frictionScale_ = 1;   // friction tangents x this (settling: locked)
 	bool settleTried_ = false;
 	int settleSteps_ = 0, settledBlocks_ = 0;
