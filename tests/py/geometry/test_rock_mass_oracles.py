@@ -442,8 +442,8 @@ def test_a_confined_mass_settles_and_stays_at_rest(scene, kind, seed, side, dura
 # at its end is its out-of-balance acceleration at the settled state times dt (reactions that build
 # within the step only resist). The settling's quiet test admits 1e-4 g (kSettleQuietAcceleration);
 # this bound is 50 times looser, for contacts that close within the step. Seed 2 of the 6 m oblique
-# mass ended a settling whose static steps kept friction on contacts that had opened with a block
-# 0.18 g out of balance; seed 1 of the 5 m one, settled with no final passes that settle the limits
+# mass, when the static steps kept friction on contacts that had opened, started with a block 0.18 g
+# out of balance; seed 1 of the 5 m one, settled without the final passes that settle the limits
 # within a step, 8.7e-3 g. The cost bound is the one above: with their limits settled pass by pass
 # in every static step, the true friction's steps made 80 solves each (seed 2, 6 m).
 UNBALANCED = 5e-3    # [g]
