@@ -53,6 +53,8 @@ import numpy as np
 # imported here, not at first use: its import would otherwise count as setup time
 from scipy.sparse import bsr_matrix
 
+import benchtasks  # bench/benchtasks.py: the RESULT protocol and the timed steps
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 B = 12                  # unknowns per block row
 RIGID = 6               # unknowns of a rigid block (its strain rows 6..11 are not unknowns)
@@ -424,7 +426,7 @@ def solve_file(path, repeats):
                       haloShare=halo_s / solve_s, allreduceShare=reduce_s / solve_s,
                       computeImbalance=max(compute) / float(np.mean(compute)), ranks=ranks)
         result.update(compare_with_reference(system, pieces))
-        print('RESULT ' + json.dumps(result), flush=True)
+        benchtasks.printResult(result)
 
 
 def compare_with_reference(system, pieces):
@@ -453,11 +455,7 @@ def mpi_solve(path, procs, repeats):
                OMP_NUM_THREADS='1', OPENBLAS_NUM_THREADS='1')
     command = ['mpirun', '-n', str(procs), '--oversubscribe'] + (['--allow-run-as-root'] if os.geteuid() == 0 else [])
     command += [sys.executable, os.path.abspath(__file__), '--solve', path, '--repeats', str(repeats)]
-    proc = subprocess.run(command, capture_output=True, text=True, env=env)
-    lines = [line for line in proc.stdout.splitlines() if line.startswith('RESULT ')]
-    if proc.returncode != 0 or not lines:
-        raise SystemExit('%s failed:\n%s\n%s' % (' '.join(command), proc.stdout[-2000:], proc.stderr[-3000:]))
-    return json.loads(lines[-1][len('RESULT '):])
+    return benchtasks.resultOf(command, ' '.join(command), env=env)
 
 
 def run_side(side, seed, procs, repeats, out):

@@ -23,9 +23,10 @@ face (tests/py/rockmass_scenes.py, draw_case), e.g. oblique-6-1-p0.7-s60.
 import argparse
 import json
 import os
-import subprocess
 import sys
 import time
+
+import benchtasks  # bench/benchtasks.py: the RESULT protocol and the timed steps
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 DEFAULT_CASES = ','.join(['junctions'] + ['%s-4-%d' % (kind, seed) for kind in ('oblique', 'orthogonal')
@@ -85,17 +86,12 @@ def main():
     args = parser.parse_args()
     settings = {k: float(v) for k, v in (item.split('=', 1) for item in args.set)}
     if args.one:
-        print('RESULT ' + json.dumps(run_case(args.one, args.time, settings)))
+        benchtasks.printResult(run_case(args.one, args.time, settings))
         return
     rows = []
     for name in args.cases.split(','):
-        out = subprocess.run([sys.executable, os.path.abspath(__file__), '--one', name, '--time', str(args.time)]
-                             + ['--set=' + item for item in args.set], capture_output=True, text=True)
-        line = [l for l in out.stdout.splitlines() if l.startswith('RESULT ')]
-        if not line:
-            sys.stderr.write(out.stdout[-2000:] + out.stderr[-2000:])
-            raise SystemExit('case %s wrote no result' % name)
-        rows.append(json.loads(line[0][7:]))
+        rows.append(benchtasks.resultOf([sys.executable, os.path.abspath(__file__), '--one', name, '--time',
+                                         str(args.time)] + ['--set=' + item for item in args.set], 'case %s' % name))
         r = rows[-1]
         print('%-14s %5d blocks %4d free  settle %2d steps %5d solves %-5s unsettled %d %6.1f s | %4d steps  solves %5.2f '
               '(most %2d)  passes %.2f  cuts %d  '

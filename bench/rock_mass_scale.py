@@ -29,29 +29,9 @@ import subprocess
 import sys
 import time
 
+import benchtasks  # bench/benchtasks.py: the RESULT protocol and the timed steps
+
 HERE = os.path.dirname(os.path.abspath(__file__))
-
-
-def timed_steps(steps, yade_dda, O):
-    """Steps the scene `steps` times: a dict of the mean numbers a step."""
-    wall = narrow = assembly = solve = 0.0
-    solves = iterations = iterated = aggregates = cuts = 0
-    for _ in range(steps):
-        t = time.time()
-        O.step()
-        wall += time.time() - t
-        s = yade_dda.stats()
-        solves += s['openCloseIterationsTotal']
-        iterations += s['iterativeIterations']
-        iterated += s['iterativeComponents']
-        aggregates = max(aggregates, s['coarseAggregates'])
-        cuts += s['stepCuts']
-        narrow += s['time']['narrowPhase']
-        assembly += s['time']['assembly']
-        solve += s['time']['solve']
-    return dict(msPerStep=1e3 * wall / steps, msNarrowPhase=1e3 * narrow / steps, msAssembly=1e3 * assembly / steps,
-                msSolve=1e3 * solve / steps, solvesPerStep=solves / steps,
-                iterationsPerSolve=iterations / max(iterated, 1), coarseAggregates=aggregates, stepCuts=cuts)
 
 
 def run_case(side, steps, settings):
@@ -71,9 +51,9 @@ def run_case(side, steps, settings):
                settleSteps=first['settleSteps'], settleSolves=first['settleSolves'],
                settleConverged=bool(first['settleConverged']), unsettled=len(first['unsettledBlocks']),
                memoryPerBlock=memory / len(ids))
-    row['oneThread'] = timed_steps(steps, yade_dda, O)
+    row['oneThread'] = benchtasks.timedSteps(steps)
     O.engines[0].threads = 2
-    row['twoThreads'] = timed_steps(steps, yade_dda, O)
+    row['twoThreads'] = benchtasks.timedSteps(steps)
     row['largestSpeed'] = max(O.bodies[i].state.vel.norm() for i in free)
     row['peakResidentPerBlock'] = 1024.0 * resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / len(ids)
     return row
@@ -118,16 +98,12 @@ def main():
     args = parser.parse_args()
     settings = {k: float(v) for k, v in (item.split('=', 1) for item in args.set)}
     if args.one:
-        print('RESULT ' + json.dumps(run_case(float(args.one), args.steps, settings)))
+        benchtasks.printResult(run_case(float(args.one), args.steps, settings))
         return
     rows = []
     for side in args.sides.split(','):
-        proc = subprocess.run([sys.executable, os.path.abspath(__file__), '--one', side, '--steps', str(args.steps)]
-                              + ['--set=' + item for item in args.set], capture_output=True, text=True)
-        lines = [line for line in proc.stdout.splitlines() if line.startswith('RESULT ')]
-        if proc.returncode != 0 or not lines:
-            raise SystemExit('mass of side %s failed:\n%s' % (side, proc.stderr[-3000:]))
-        r = json.loads(lines[-1][len('RESULT '):])
+        r = benchtasks.resultOf([sys.executable, os.path.abspath(__file__), '--one', side, '--steps', str(args.steps)]
+                                + ['--set=' + item for item in args.set], 'mass of side %s' % side)
         rows.append(r)
         one, two = r['oneThread'], r['twoThreads']
         print('%4s m %6d blocks %6d free | settle %7.1f s %3d steps %5d solves %-5s | %8.1f ms/step (narrow %.1f, '

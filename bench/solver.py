@@ -21,7 +21,8 @@ import json
 import os
 import subprocess
 import sys
-import time
+
+import benchtasks  # bench/benchtasks.py: the RESULT protocol and the timed steps
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 
@@ -29,7 +30,6 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 def run_case(side, path, threads, steps):
     """One case in this process: a dict of its numbers."""
     sys.path.insert(0, os.path.join(HERE, '..', 'tests', 'py'))
-    import yade_dda
     from yade_dda import O
     import rockmass_scenes as R
     case = R.draw_case(1, kind='oblique', side=side)
@@ -38,26 +38,8 @@ def run_case(side, path, threads, steps):
         settings['iterativeSolveBlocks'] = 0
     ids, fixed, free = R.build_scene(case, **settings)
     O.step()   # the first step builds the contact network
-    wall = solve = assembly = narrow = 0.0
-    solves = iterations = iterated = largest = fallbacks = 0
-    for _ in range(steps):
-        t = time.time()
-        O.step()
-        wall += time.time() - t
-        s = yade_dda.stats()
-        solves += s['openCloseIterationsTotal']
-        iterations += s['iterativeIterations']
-        iterated += s['iterativeComponents']
-        fallbacks += s['iterativeFallbacks']
-        largest = max(largest, s['largestComponent'])
-        solve += s['time']['solve']
-        assembly += s['time']['assembly']
-        narrow += s['time']['narrowPhase']
     return dict(side=side, path=path, threads=threads, description=R.describe(case), blocks=len(ids),
-                free=len(free), largestComponent=largest, steps=steps, solvesPerStep=solves / steps,
-                msPerSolve=1e3 * solve / max(solves, 1), iterationsPerSolve=iterations / max(iterated, 1),
-                iterativeFallbacks=fallbacks, msPerStep=1e3 * wall / steps, msSolve=1e3 * solve / steps,
-                msAssembly=1e3 * assembly / steps, msNarrowPhase=1e3 * narrow / steps)
+                free=len(free), steps=steps, **benchtasks.timedSteps(steps))
 
 
 def plot(rows, path):
@@ -92,18 +74,15 @@ def main():
     args = parser.parse_args()
     if args.one:
         side, path, threads = args.one.split(',')
-        print('RESULT ' + json.dumps(run_case(float(side), path, int(threads), args.steps)))
+        benchtasks.printResult(run_case(float(side), path, int(threads), args.steps))
         return
     rows = []
     for side in [float(s) for s in args.sides.split(',')]:
         runs = [('iterative', 1), ('iterative', 2)] + ([('direct', 1)] if side <= args.direct_up_to else [])
         for path, threads in runs:
-            proc = subprocess.run([sys.executable, os.path.abspath(__file__), '--one', '%g,%s,%d' % (side, path, threads),
-                                   '--steps', str(args.steps)], capture_output=True, text=True)
-            lines = [line for line in proc.stdout.splitlines() if line.startswith('RESULT ')]
-            if proc.returncode != 0 or not lines:
-                raise SystemExit('case %g %s %d failed:\n%s' % (side, path, threads, proc.stderr[-3000:]))
-            row = json.loads(lines[-1][len('RESULT '):])
+            row = benchtasks.resultOf([sys.executable, os.path.abspath(__file__), '--one',
+                                       '%g,%s,%d' % (side, path, threads), '--steps', str(args.steps)],
+                                      'case %g %s %d' % (side, path, threads))
             rows.append(row)
             print('%4g m %5d free %-9s %d thr: %5.1f solves/step, %8.2f ms/solve, %6.1f iterations/solve, '
                   '%8.1f ms/step (solve %8.1f, assembly %6.1f, narrow %5.1f)' % (
